@@ -1,0 +1,50 @@
+// orbis/features/descriptor.hpp — the 256-bit binary ORB descriptor and its Hamming distance.
+//
+// Contract: OrbDescriptor is 32 bytes stored as four 64-bit words (trivially copyable, 8-byte
+// aligned); hammingDistance uses the hardware popcount when the compiler enables it. The
+// distance policy HammingDistance is what the matchers and the vocabulary are templated on.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+
+namespace orbis {
+
+struct OrbDescriptor {
+  static constexpr int kBits = 256;
+  static constexpr int kBytes = 32;
+  std::array<std::uint64_t, 4> words{};
+
+  const std::uint8_t* bytes() const { return reinterpret_cast<const std::uint8_t*>(words.data()); }
+  std::uint8_t* bytes() { return reinterpret_cast<std::uint8_t*>(words.data()); }
+  bool bit(int i) const { return (words[static_cast<std::size_t>(i >> 6)] >> (i & 63)) & 1u; }
+  void setBit(int i, bool v) {
+    const std::uint64_t m = std::uint64_t{1} << (i & 63);
+    auto& w = words[static_cast<std::size_t>(i >> 6)];
+    w = v ? (w | m) : (w & ~m);
+  }
+  // From the 32 bytes of an OpenCV descriptor row (CV_8U, 32 columns).
+  static OrbDescriptor fromBytes(const std::uint8_t* src) {
+    OrbDescriptor d;
+    std::memcpy(d.words.data(), src, kBytes);
+    return d;
+  }
+  friend bool operator==(const OrbDescriptor&, const OrbDescriptor&) = default;
+};
+
+inline int hammingDistance(const OrbDescriptor& a, const OrbDescriptor& b) {
+  return std::popcount(a.words[0] ^ b.words[0]) + std::popcount(a.words[1] ^ b.words[1]) +
+         std::popcount(a.words[2] ^ b.words[2]) + std::popcount(a.words[3] ^ b.words[3]);
+}
+
+// Distance policy for templates over descriptor types (matchers, vocabulary).
+struct HammingDistance {
+  using Descriptor = OrbDescriptor;
+  using Distance = int;
+  static constexpr int kMax = OrbDescriptor::kBits;
+  int operator()(const OrbDescriptor& a, const OrbDescriptor& b) const { return hammingDistance(a, b); }
+};
+
+}  // namespace orbis
