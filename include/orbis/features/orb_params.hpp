@@ -1,0 +1,17 @@
+// orbis/features/orb_params.hpp — parameters of the ORB extractor (settings keys ORBextractor.*).
+//
+// Contract: plain values with ORB-SLAM2's defaults; the settings reader fills them from
+// ORBextractor.nFeatures, .scaleFactor, .nLevels, .iniThFAST and .minThFAST.
+#pragma once
+
+namespace orbis {
+
+struct OrbParams {
+  int features = 1000;       // total keypoint budget over all pyramid levels
+  float scaleFactor = 1.2f;  // ratio between consecutive pyramid levels
+  int levels = 8;            // pyramid levels
+  int iniThFast = 20;        // FAST threshold tried first in each grid cell
+  int minThFast = 7;         // fallback FAST threshold for cells where nothing was found
+};
+
+}  // namespace orbis
