@@ -1,0 +1,19 @@
+// orbis/io/ply.hpp — writes point clouds as binary little-endian PLY (x, y, z float; optional rgb).
+//
+// Contract: writePly throws orbis::Error naming the path when the file cannot be written;
+// colours, when given, must have one entry per point.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace orbis {
+
+void writePly(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& points,
+              const std::vector<std::array<std::uint8_t, 3>>& colours = {});
+
+}  // namespace orbis

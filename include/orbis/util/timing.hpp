@@ -1,0 +1,76 @@
+// orbis/util/timing.hpp — per-stage wall-clock statistics in the manner of the paper's Table IV.
+//
+// Contract: StageTimer records durations (ms) under stage names; summary() gives count, mean,
+// median, p95 and max per stage, in the order stages were first recorded. Thread-safe: the
+// tracking, local-mapping and loop-closing threads record into one instance.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace orbis {
+
+struct StageStats {
+  std::string stage;
+  std::size_t count = 0;
+  double meanMs = 0, medianMs = 0, p95Ms = 0, maxMs = 0;
+};
+
+class StageTimer {
+ public:
+  void record(const std::string& stage, double ms) {
+    std::lock_guard lock(mutex_);
+    for (auto& [name, samples] : stages_)
+      if (name == stage) { samples.push_back(ms); return; }
+    stages_.emplace_back(stage, std::vector<double>{ms});
+  }
+
+  std::vector<StageStats> summary() const {
+    std::lock_guard lock(mutex_);
+    std::vector<StageStats> out;
+    for (const auto& [name, samplesIn] : stages_) {
+      std::vector<double> s = samplesIn;
+      std::sort(s.begin(), s.end());
+      StageStats st;
+      st.stage = name;
+      st.count = s.size();
+      double sum = 0;
+      for (double v : s) sum += v;
+      st.meanMs = sum / static_cast<double>(s.size());
+      st.medianMs = s.size() % 2 ? s[s.size() / 2] : 0.5 * (s[s.size() / 2 - 1] + s[s.size() / 2]);
+      st.p95Ms = s[std::min(s.size() - 1, static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(s.size()))) - 1)];
+      st.maxMs = s.back();
+      out.push_back(st);
+    }
+    return out;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::pair<std::string, std::vector<double>>> stages_;
+};
+
+// Measures the scope it lives in and records it into a StageTimer (or nowhere, if null).
+class ScopedStage {
+ public:
+  ScopedStage(StageTimer* timer, std::string stage)
+      : timer_(timer), stage_(std::move(stage)), start_(std::chrono::steady_clock::now()) {}
+  ~ScopedStage() {
+    if (timer_)
+      timer_->record(stage_, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
+  }
+  ScopedStage(const ScopedStage&) = delete;
+  ScopedStage& operator=(const ScopedStage&) = delete;
+
+ private:
+  StageTimer* timer_;
+  std::string stage_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace orbis
