@@ -1,0 +1,52 @@
+// orbis/camera/camera_model.hpp — the CameraModel concept and its traits.
+//
+// Contract: a camera model is a small value type, templated on its scalar, that maps a point
+// in the camera frame to an observation of kObservationDim (2: pixel; 3: (uL, v, uR)) rows
+// and back, with the analytic Jacobian of the projection. Code generic over cameras takes
+// `template <CameraModel Camera>` and asks CameraTraits<Camera> (or the members) for the
+// observation size, whether depth is metric, and the close/far depth threshold.
+// A new camera is one struct that satisfies the concept; nothing else changes.
+//
+// A type that is not a camera fails with the concept's name in the diagnostic, for instance
+//   static_assert(orbis::CameraModel<int>);        // error: ... 'int' does not satisfy CameraModel
+// tests/camera/camera_model_test.cpp holds such negative checks.
+#pragma once
+
+#include <concepts>
+
+#include <Eigen/Core>
+
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/camera/stereo.hpp"
+
+namespace orbis {
+
+template <class C>
+concept CameraModel =
+    std::floating_point<typename C::Scalar> &&
+    (C::kObservationDim == 2 || C::kObservationDim == 3) &&
+    std::convertible_to<decltype(C::kMetricDepth), bool> &&
+    requires(const C& camera, const Eigen::Matrix<typename C::Scalar, 3, 1>& pc,
+             const Eigen::Matrix<typename C::Scalar, 2, 1>& px, typename C::Scalar value) {
+      { camera.project(pc) } -> std::same_as<Eigen::Matrix<typename C::Scalar, C::kObservationDim, 1>>;
+      { camera.projectJacobian(pc) } -> std::same_as<Eigen::Matrix<typename C::Scalar, C::kObservationDim, 3>>;
+      { camera.unproject(px, value) } -> std::same_as<Eigen::Matrix<typename C::Scalar, 3, 1>>;
+      { C::inFront(pc) } -> std::same_as<bool>;
+      { camera.inImage(value, value) } -> std::same_as<bool>;
+      { camera.closeDepthThreshold() } -> std::same_as<typename C::Scalar>;
+    };
+
+template <CameraModel C>
+struct CameraTraits {
+  using Scalar = typename C::Scalar;
+  using Observation = Eigen::Matrix<Scalar, C::kObservationDim, 1>;
+  static constexpr int kObservationDim = C::kObservationDim;
+  static constexpr bool kMetricDepth = C::kMetricDepth;
+  static Scalar closeDepthThreshold(const C& camera) { return camera.closeDepthThreshold(); }
+};
+
+static_assert(CameraModel<PinholeCamera<double>> && CameraModel<PinholeCamera<float>>);
+static_assert(CameraModel<RectifiedStereoCamera<double>> && CameraModel<RectifiedStereoCamera<float>>);
+static_assert(CameraModel<RgbdCamera<double>> && CameraModel<RgbdCamera<float>>);
+
+}  // namespace orbis
