@@ -1,0 +1,84 @@
+// orbis/geometry/lie_group.hpp — what every Lie group of orbis provides, and shared numerics.
+//
+// Contract: a LieGroup G (SO3, SE3, Sim3, each templated on its Scalar) is a value type whose
+// default constructor is the identity. G::exp maps a tangent vector (G::Tangent, G::kDoF
+// entries, ordered as in Sophus) to the group and g.log() maps back; log∘exp is the identity
+// for rotation angles in [0, π). Composition is operator*, acting on 3-D points is operator*
+// with G::Point. g.Adj() satisfies g·exp(ξ)·g⁻¹ = exp(Adj·ξ); hat/vee convert between tangent
+// vectors and the Lie algebra's matrices (G::kMatrixDim square). pointJacobianLeft(q) is the
+// derivative of exp(δ)·q with respect to δ at δ = 0, q being the already-transformed point.
+// Nothing here allocates or throws; all types are fixed-size Eigen and safe in std::vector.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <concepts>
+
+namespace orbis {
+
+template <class G>
+concept LieGroup = requires(const G g, const typename G::Tangent xi, const typename G::Point p,
+                            const typename G::Transformation m) {
+  typename G::Scalar;
+  requires std::same_as<typename G::Tangent, Eigen::Matrix<typename G::Scalar, G::kDoF, 1>>;
+  requires std::same_as<typename G::Point, Eigen::Matrix<typename G::Scalar, 3, 1>>;
+  { G() };
+  { G::exp(xi) } -> std::same_as<G>;
+  { g.log() } -> std::same_as<typename G::Tangent>;
+  { g.inverse() } -> std::same_as<G>;
+  { g * g } -> std::same_as<G>;
+  { g * p } -> std::same_as<typename G::Point>;
+  { g.matrix() } -> std::same_as<typename G::Transformation>;
+  { g.Adj() } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  { G::hat(xi) } -> std::same_as<typename G::Transformation>;
+  { G::vee(m) } -> std::same_as<typename G::Tangent>;
+  { G::pointJacobianLeft(p) } -> std::same_as<Eigen::Matrix<typename G::Scalar, 3, G::kDoF>>;
+  { g.template cast<double>() };
+};
+
+// Groups whose exp has closed-form left/right Jacobians and inverses (SO3, SE3, Sim3):
+//   exp(ξ + δ) ≈ exp(leftJacobian(ξ)·δ)·exp(ξ) ≈ exp(ξ)·exp(rightJacobian(ξ)·δ).
+template <class G>
+concept LieGroupWithJacobians = LieGroup<G> && requires(const typename G::Tangent xi) {
+  { G::leftJacobian(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  { G::leftJacobianInverse(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  { G::rightJacobian(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  { G::rightJacobianInverse(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+};
+
+namespace lie_detail {
+
+// Below this angle the closed forms lose digits to cancellation (the worst, (2θ−3sinθ+θcosθ)/θ⁵
+// in SE3's Q, loses ~ε/θ absolute), so Taylor series to θ⁴ take over; their truncation error is
+// below ε at the threshold. float needs a much larger threshold than double.
+template <class S>
+inline S smallAngle() {
+  return S(1e-2);
+}
+template <>
+inline float smallAngle<float>() {
+  return 0.25f;
+}
+
+// How far |q|² may drift from 1 before a product renormalises (a few ulps of accumulated rounding).
+template <class S>
+inline S quaternionDriftTolerance() {
+  return S(1e-12);
+}
+template <>
+inline float quaternionDriftTolerance<float>() {
+  return 1e-6f;
+}
+
+template <class S>
+inline Eigen::Matrix<S, 3, 3> skew(const Eigen::Matrix<S, 3, 1>& v) {
+  Eigen::Matrix<S, 3, 3> m;
+  m << S(0), -v.z(), v.y(),  //
+      v.z(), S(0), -v.x(),   //
+      -v.y(), v.x(), S(0);
+  return m;
+}
+
+}  // namespace lie_detail
+}  // namespace orbis

@@ -1,0 +1,335 @@
+// One typed harness for every Lie group × scalar: group axioms, exp/log round trips (random,
+// near identity, near π), adjoint, hat/vee, action vs. matrix, and every analytic Jacobian
+// against central differences. A new group is tested by adding it to GroupTypes below.
+#include "orbis/geometry/se3.hpp"
+#include "orbis/geometry/so3.hpp"
+
+#include <gtest/gtest.h>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <cmath>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace orbis {
+namespace {
+
+static_assert(LieGroupWithJacobians<SO3d> && LieGroupWithJacobians<SO3f>);
+static_assert(LieGroupWithJacobians<SE3d> && LieGroupWithJacobians<SE3f>);
+
+constexpr double kPi = std::numbers::pi;
+
+template <class G>
+using Scalar = typename G::Scalar;
+template <class G>
+using DoubleOf = decltype(G().template cast<double>());
+
+// Tolerances per scalar type. "value" bounds round-trip errors of O(1) quantities; "jacobian"
+// bounds |analytic − numeric| where numeric is a central difference of the double instantiation
+// (step 1e-5, itself accurate to ~1e-10), so for float it measures float's own rounding.
+template <class S>
+struct Tol;
+template <>
+struct Tol<double> {
+  static constexpr double value = 1e-10;
+  static constexpr double relative = 1e-12;
+  static constexpr double jacobian = 1e-8;
+};
+template <>
+struct Tol<float> {
+  static constexpr double value = 2e-5;
+  static constexpr double relative = 1e-5;
+  static constexpr double jacobian = 1e-5;
+};
+
+template <class G>
+std::string groupName() {
+  std::string name = G::kDoF == 3 ? "SO3" : G::kDoF == 6 ? "SE3" : "Sim3";
+  return name + (std::is_same_v<Scalar<G>, float> ? "<float>" : "<double>");
+}
+
+// Where the rotation vector sits in the tangent: SO3 (ω), SE3 (υ, ω), Sim3 (υ, ω, σ).
+template <class G>
+constexpr int kRotationOffset = G::kDoF == 3 ? 0 : 3;
+
+// A tangent whose rotation part has exactly the given angle (random axis) and whose other
+// parts are uniform in [−linearScale, linearScale].
+template <class G>
+typename G::Tangent makeTangent(std::mt19937& rng, double angle, double linearScale) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::Matrix<double, G::kDoF, 1> xi;
+  for (int i = 0; i < G::kDoF; ++i) xi[i] = linearScale * unit(rng);
+  Eigen::Vector3d axis(unit(rng), unit(rng), unit(rng));
+  axis.normalize();
+  xi.template segment<3>(kRotationOffset<G>) = angle * axis;
+  return xi.template cast<Scalar<G>>();
+}
+
+template <class G>
+G randomElement(std::mt19937& rng) {
+  std::uniform_real_distribution<double> angle(0.0, kPi - 0.01);
+  return G::exp(makeTangent<G>(rng, angle(rng), 2.0));
+}
+
+template <class G>
+typename G::Point randomPoint(std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-3.0, 3.0);
+  return Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).cast<Scalar<G>>();
+}
+
+// The group's action through its matrix, as a check on operator*(Point).
+template <class G>
+typename G::Point applyMatrix(const G& g, const typename G::Point& p) {
+  if constexpr (G::kMatrixDim == 3) {
+    return g.matrix() * p;
+  } else {
+    return (g.matrix() * p.homogeneous()).template head<3>();
+  }
+}
+
+template <class G>
+double matrixDistance(const G& a, const G& b) {
+  return (a.matrix().template cast<double>() - b.matrix().template cast<double>())
+      .cwiseAbs()
+      .maxCoeff();
+}
+
+// Central differences of f: R^N -> R^M at 0, in double.
+template <int M, int N, class F>
+Eigen::Matrix<double, M, N> numericJacobian(F f, double step = 1e-5) {
+  Eigen::Matrix<double, M, N> j;
+  for (int c = 0; c < N; ++c) {
+    Eigen::Matrix<double, N, 1> d = Eigen::Matrix<double, N, 1>::Zero();
+    d[c] = step;
+    j.col(c) = (f(d) - f(-d)) / (2.0 * step);
+  }
+  return j;
+}
+
+template <class G>
+class LieGroupTest : public ::testing::Test {
+ protected:
+  using S = Scalar<G>;
+  using Tangent = typename G::Tangent;
+  std::mt19937 rng{20240611u};
+
+  // Tangents for round trips: random angles in [0, π), near identity, near π.
+  std::vector<Tangent> roundTripTangents() {
+    std::vector<Tangent> out;
+    std::uniform_real_distribution<double> angle(0.0, kPi - 1e-3);
+    for (int i = 0; i < 40; ++i) out.push_back(makeTangent<G>(rng, angle(rng), 2.0));
+    for (int i = 0; i < 5; ++i) out.push_back(makeTangent<G>(rng, kPi - 1e-6, 2.0));
+    for (int i = 0; i < 5; ++i) out.push_back(makeTangent<G>(rng, 0.0, 2.0));  // pure translation
+    return out;
+  }
+
+  // Tangents for Jacobian checks: random, near identity, both sides of the Taylor switch, and
+  // near π (not closer than 1e-3: log is discontinuous at π, so differences across it are void).
+  std::vector<Tangent> jacobianTangents() {
+    std::vector<Tangent> out;
+    std::uniform_real_distribution<double> angle(0.0, kPi - 0.05);
+    for (int i = 0; i < 20; ++i) out.push_back(makeTangent<G>(rng, angle(rng), 1.5));
+    out.push_back(makeTangent<G>(rng, 1e-9, 1.5));
+    out.push_back(makeTangent<G>(rng, 1e-9, 1e-9));
+    const double threshold = double(lie_detail::smallAngle<S>());
+    out.push_back(makeTangent<G>(rng, 0.999 * threshold, 1.5));
+    out.push_back(makeTangent<G>(rng, 1.001 * threshold, 1.5));
+    out.push_back(makeTangent<G>(rng, kPi - 1e-3, 1.5));
+    return out;
+  }
+
+  // Checks one analytic Jacobian over all test tangents and prints the largest discrepancy.
+  template <class Analytic, class Numeric>
+  void checkJacobian(const char* name, Analytic analytic, Numeric numeric) {
+    double worst = 0.0;
+    for (const Tangent& xi : jacobianTangents()) {
+      const auto a = analytic(xi).template cast<double>().eval();
+      const auto n = numeric(xi.template cast<double>().eval());
+      const double diff = (a - n).cwiseAbs().maxCoeff();
+      EXPECT_LT(diff, Tol<S>::jacobian) << name << " at xi = " << xi.transpose() << "\nanalytic\n"
+                                        << a << "\nnumeric\n" << n;
+      worst = std::max(worst, diff);
+    }
+    std::cout << "[jacobian] " << groupName<G>() << " " << name << " max|diff| = " << worst
+              << std::endl;
+  }
+};
+
+using GroupTypes = ::testing::Types<SO3f, SO3d, SE3f, SE3d>;
+
+class GroupNames {
+ public:
+  template <class G>
+  static std::string GetName(int) {
+    std::string n = groupName<G>();
+    for (char& c : n)
+      if (c == '<' || c == '>') c = '_';
+    return n;
+  }
+};
+TYPED_TEST_SUITE(LieGroupTest, GroupTypes, GroupNames);
+
+TYPED_TEST(LieGroupTest, GroupAxioms) {
+  using G = TypeParam;
+  const double tol = Tol<Scalar<G>>::value;
+  for (int i = 0; i < 30; ++i) {
+    const G a = randomElement<G>(this->rng), b = randomElement<G>(this->rng),
+            c = randomElement<G>(this->rng);
+    EXPECT_LT(matrixDistance<G>((a * b) * c, a * (b * c)), 10 * tol);
+    EXPECT_LT(matrixDistance<G>(G() * a, a), tol);
+    EXPECT_LT(matrixDistance<G>(a * G(), a), tol);
+    EXPECT_LT(matrixDistance<G>(a * a.inverse(), G()), 10 * tol);
+    EXPECT_LT(matrixDistance<G>(a.inverse() * a, G()), 10 * tol);
+    // The matrix representation is a homomorphism.
+    const auto product = (a.matrix() * b.matrix()).eval();
+    EXPECT_LT(((a * b).matrix() - product).cwiseAbs().maxCoeff(), 10 * tol);
+  }
+}
+
+TYPED_TEST(LieGroupTest, ExpLogRoundTrip) {
+  using G = TypeParam;
+  const double tol = Tol<Scalar<G>>::value;
+  for (const auto& xi : this->roundTripTangents()) {
+    const G g = G::exp(xi);
+    const double diff = (g.log() - xi).template cast<double>().cwiseAbs().maxCoeff();
+    EXPECT_LT(diff, 20 * tol) << "log(exp(xi)) != xi for xi = " << xi.transpose();
+    EXPECT_LT(matrixDistance<G>(G::exp(g.log()), g), 20 * tol);
+  }
+  for (int i = 0; i < 20; ++i) {
+    const G g = randomElement<G>(this->rng);
+    EXPECT_LT(matrixDistance<G>(G::exp(g.log()), g), 20 * tol);
+  }
+}
+
+TYPED_TEST(LieGroupTest, ExpLogNearIdentityIsRelativelyExact) {
+  using G = TypeParam;
+  for (int i = 0; i < 20; ++i) {
+    const auto xi = makeTangent<G>(this->rng, 1e-9, 1e-9);
+    const auto back = G::exp(xi).log();
+    const double rel = (back - xi).template cast<double>().norm() / xi.template cast<double>().norm();
+    EXPECT_LT(rel, Tol<Scalar<G>>::relative) << "xi = " << xi.transpose();
+  }
+  EXPECT_EQ(G::exp(G::Tangent::Zero()).log(), G::Tangent::Zero());
+}
+
+TYPED_TEST(LieGroupTest, ExpMatchesMatrixExponentialOfHat) {
+  using G = TypeParam;
+  using GD = DoubleOf<G>;
+  for (const auto& xi : this->roundTripTangents()) {
+    const auto xd = xi.template cast<double>().eval();
+    const auto expected = GD::hat(xd).exp().eval();
+    const double diff = (G::exp(xi).matrix().template cast<double>() - expected).cwiseAbs().maxCoeff();
+    EXPECT_LT(diff, 20 * Tol<Scalar<G>>::value) << "xi = " << xi.transpose();
+  }
+}
+
+TYPED_TEST(LieGroupTest, HatVeeRoundTrip) {
+  using G = TypeParam;
+  for (const auto& xi : this->roundTripTangents()) EXPECT_EQ(G::vee(G::hat(xi)), xi);
+}
+
+TYPED_TEST(LieGroupTest, AdjointConjugatesExp) {
+  using G = TypeParam;
+  const double tol = Tol<Scalar<G>>::value;
+  std::uniform_real_distribution<double> angle(0.0, 2.5);
+  for (int i = 0; i < 30; ++i) {
+    const G g = randomElement<G>(this->rng);
+    const auto xi = makeTangent<G>(this->rng, angle(this->rng), 1.0);
+    const typename G::Tangent adjXi = g.Adj() * xi;
+    EXPECT_LT(matrixDistance<G>(G::exp(adjXi), g * G::exp(xi) * g.inverse()), 50 * tol);
+  }
+}
+
+TYPED_TEST(LieGroupTest, ActionOnPointsMatchesMatrix) {
+  using G = TypeParam;
+  const double tol = Tol<Scalar<G>>::value;
+  for (int i = 0; i < 30; ++i) {
+    const G g = randomElement<G>(this->rng);
+    const auto p = randomPoint<G>(this->rng);
+    const double diff = (g * p - applyMatrix(g, p)).template cast<double>().cwiseAbs().maxCoeff();
+    EXPECT_LT(diff, 50 * tol);
+    const double back = (g.inverse() * (g * p) - p).template cast<double>().cwiseAbs().maxCoeff();
+    EXPECT_LT(back, 50 * tol);
+  }
+}
+
+TYPED_TEST(LieGroupTest, CastPreservesElement) {
+  using G = TypeParam;
+  const G g = randomElement<G>(this->rng);
+  const auto d = g.template cast<double>();
+  EXPECT_LT((d.matrix() - g.matrix().template cast<double>()).cwiseAbs().maxCoeff(), 1e-6);
+  const auto back = d.template cast<Scalar<G>>();
+  EXPECT_LT(matrixDistance<G>(back, g), Tol<Scalar<G>>::value);
+}
+
+TYPED_TEST(LieGroupTest, LeftJacobian) {
+  using G = TypeParam;
+  using GD = DoubleOf<G>;
+  this->checkJacobian(
+      "leftJacobian", [](const auto& xi) { return G::leftJacobian(xi); },
+      [](const typename GD::Tangent& xi) {
+        const GD base = GD::exp(xi);
+        return numericJacobian<G::kDoF, G::kDoF>(
+            [&](const typename GD::Tangent& d) { return (GD::exp(xi + d) * base.inverse()).log(); });
+      });
+}
+
+TYPED_TEST(LieGroupTest, RightJacobian) {
+  using G = TypeParam;
+  using GD = DoubleOf<G>;
+  this->checkJacobian(
+      "rightJacobian", [](const auto& xi) { return G::rightJacobian(xi); },
+      [](const typename GD::Tangent& xi) {
+        const GD baseInv = GD::exp(xi).inverse();
+        return numericJacobian<G::kDoF, G::kDoF>(
+            [&](const typename GD::Tangent& d) { return (baseInv * GD::exp(xi + d)).log(); });
+      });
+}
+
+TYPED_TEST(LieGroupTest, LeftJacobianInverse) {
+  using G = TypeParam;
+  using GD = DoubleOf<G>;
+  this->checkJacobian(
+      "leftJacobianInverse", [](const auto& xi) { return G::leftJacobianInverse(xi); },
+      [](const typename GD::Tangent& xi) {
+        const GD base = GD::exp(xi);
+        return numericJacobian<G::kDoF, G::kDoF>(
+            [&](const typename GD::Tangent& d) { return (GD::exp(d) * base).log(); });
+      });
+}
+
+TYPED_TEST(LieGroupTest, RightJacobianInverse) {
+  using G = TypeParam;
+  using GD = DoubleOf<G>;
+  this->checkJacobian(
+      "rightJacobianInverse", [](const auto& xi) { return G::rightJacobianInverse(xi); },
+      [](const typename GD::Tangent& xi) {
+        const GD base = GD::exp(xi);
+        return numericJacobian<G::kDoF, G::kDoF>(
+            [&](const typename GD::Tangent& d) { return (base * GD::exp(d)).log(); });
+      });
+}
+
+// The test point is derived from the tangent so the shared checkJacobian can drive it.
+TYPED_TEST(LieGroupTest, PointJacobianLeft) {
+  using G = TypeParam;
+  using GD = DoubleOf<G>;
+  const auto pointFor = [](const auto& xi) {
+    using Sc = typename std::decay_t<decltype(xi)>::Scalar;
+    return Eigen::Matrix<Sc, 3, 1>(Sc(1.5) - xi[0], Sc(-0.7) + xi[1], Sc(2.0) + xi[2]);
+  };
+  this->checkJacobian(
+      "pointJacobianLeft",
+      [&](const auto& xi) { return G::pointJacobianLeft(G::exp(xi) * pointFor(xi)); },
+      [&](const typename GD::Tangent& xi) {
+        const typename GD::Point q = GD::exp(xi) * pointFor(xi);
+        return numericJacobian<3, G::kDoF>([&](const typename GD::Tangent& d) { return GD::exp(d) * q; });
+      });
+}
+
+}  // namespace
+}  // namespace orbis
