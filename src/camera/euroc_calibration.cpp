@@ -1,0 +1,34 @@
+// EuRoC sensor.yaml reader; see orbis/camera/euroc_calibration.hpp.
+#include "orbis/camera/euroc_calibration.hpp"
+
+#include "yaml_reader.hpp"
+
+namespace orbis {
+
+CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml) {
+  const detail::YamlReader yaml(sensorYaml);
+  if (const auto model = yaml.optionalString("camera_model"); model && *model != "pinhole") {
+    throw yaml.error("camera_model", "only pinhole is supported, found \"" + *model + "\"");
+  }
+  if (const auto model = yaml.optionalString("distortion_model"); model && *model != "radial-tangential") {
+    throw yaml.error("distortion_model", "only radial-tangential is supported, found \"" + *model + "\"");
+  }
+  const std::vector<double> k = yaml.reals("intrinsics", 4, 4);
+  const std::vector<double> d = yaml.reals("distortion_coefficients", 4, 5);
+  const std::vector<double> resolution = yaml.reals("resolution", 2, 2);
+  if (!(k[0] > 0 && k[1] > 0)) throw yaml.error("intrinsics", "focal lengths fu, fv must be positive");
+  if (!(resolution[0] >= 1 && resolution[1] >= 1)) throw yaml.error("resolution", "expected a positive width and height");
+
+  CameraCalibration c;
+  c.intrinsics = {k[0], k[1], k[2], k[3], static_cast<int>(resolution[0]), static_cast<int>(resolution[1])};
+  c.distortion = {d[0], d[1], d[2], d[3], d.size() == 5 ? d[4] : 0.0};
+  c.bodyFromCamera = yaml.matrix("T_BS", 4, 4);
+  const Eigen::Matrix3d R = c.bodyFromCamera.topLeftCorner<3, 3>();
+  if (!(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0 ||
+      !c.bodyFromCamera.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1))) {
+    throw yaml.error("T_BS", "expected a rigid transform (orthonormal rotation, last row 0 0 0 1)");
+  }
+  return c;
+}
+
+}  // namespace orbis
