@@ -1,0 +1,269 @@
+// orbis/optim/problem.hpp — a sparse least-squares problem over poses and 3-D points, solved by
+// Levenberg–Marquardt with the points eliminated by a Schur complement.
+//
+// Contract: Problem<PoseManifold, Term...> stores poses (on PoseManifold), points (R³) and, for
+// each Term, residual records of one compile-time residual type and robust kernel. Any pose or
+// point may be fixed; fixed values are never written. Residual records can be deactivated (outlier
+// rejection) between solves. solve() builds the block structure once, then per iteration
+// linearises with the analytic Jacobians, forms the reduced camera system
+// S = H_pp − H_pl H_ll⁻¹ H_lp (dense LLT for small systems, CHOLMOD supernodal otherwise) and
+// back-substitutes the points. Costs use Ceres' convention ½Σρ(information·‖r‖²).
+// Not thread-safe; a solve can be aborted through SolverOptions::abortFlag.
+#pragma once
+
+#include "orbis/optim/levenberg_marquardt.hpp"
+#include "orbis/optim/reduced_system.hpp"
+#include "orbis/optim/residual.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace orbis::optim {
+
+template <Manifold PoseM, class... Terms>
+class Problem {
+  static_assert(sizeof...(Terms) > 0, "a problem needs at least one residual term");
+  static_assert((std::is_same_v<typename Terms::Residual::PoseManifold, PoseM> && ...),
+                "every residual must be written against the problem's pose manifold");
+
+ public:
+  using Pose = typename PoseM::Value;
+  static constexpr int kPoseDim = PoseM::kDim;
+  static constexpr std::size_t kNumTerms = sizeof...(Terms);
+  template <std::size_t I>
+  using TermAt = std::tuple_element_t<I, std::tuple<Terms...>>;
+  template <std::size_t I>
+  using ResidualAt = typename TermAt<I>::Residual;
+
+  int addPose(const Pose& pose, bool fixed = false) {
+    poses_.push_back(pose);
+    poseFixed_.push_back(fixed);
+    return static_cast<int>(poses_.size()) - 1;
+  }
+  int addPoint(const Eigen::Vector3d& point, bool fixed = false) {
+    points_.push_back(point);
+    pointFixed_.push_back(fixed);
+    return static_cast<int>(points_.size()) - 1;
+  }
+  // other: the point of a PointResidual, pose j of a PoseResidual. delta2: kernel threshold δ².
+  template <ResidualBlock R>
+  ResidualId add(const R& residual, int pose, int other, double information = 1.0,
+                 double delta2 = std::numeric_limits<double>::infinity()) {
+    constexpr int term = termOf<R>();
+    static_assert(term >= 0, "residual type is not one of the problem's terms");
+    auto& records = std::get<term>(records_);
+    records.push_back(ResidualRecord<R>{residual, pose, other, information, delta2, true});
+    return {term, static_cast<int>(records.size()) - 1};
+  }
+
+  int numPoses() const { return static_cast<int>(poses_.size()); }
+  int numPoints() const { return static_cast<int>(points_.size()); }
+  const Pose& pose(int i) const { return poses_[i]; }
+  void setPose(int i, const Pose& pose) { poses_[i] = pose; }
+  const Eigen::Vector3d& point(int i) const { return points_[i]; }
+  void setPoint(int i, const Eigen::Vector3d& point) { points_[i] = point; }
+  bool poseFixed(int i) const { return poseFixed_[i] != 0; }
+  bool pointFixed(int i) const { return pointFixed_[i] != 0; }
+  void setPoseFixed(int i, bool fixed) { poseFixed_[i] = fixed; }
+  void setPointFixed(int i, bool fixed) { pointFixed_[i] = fixed; }
+
+  template <std::size_t I>
+  const AlignedVector<ResidualRecord<ResidualAt<I>>>& records() const {
+    return std::get<I>(records_);
+  }
+  template <std::size_t I>
+  AlignedVector<ResidualRecord<ResidualAt<I>>>& records() {
+    return std::get<I>(records_);
+  }
+
+  void setActive(ResidualId id, bool active) {
+    visitTerm(id.term, [&](auto& records) { records[id.index].active = active; });
+  }
+  bool active(ResidualId id) const {
+    bool result = false;
+    visitTerm(id.term, [&](const auto& records) { result = records[id.index].active; });
+    return result;
+  }
+  // information·‖r‖² at the current values: the statistic ORB-SLAM compares with χ² quantiles.
+  double chi2(ResidualId id) const {
+    double result = 0.0;
+    visitTerm(id.term, [&](const auto& records) {
+      const auto& rec = records[id.index];
+      result = rec.information * rawResidual(rec, poses_, points_).squaredNorm();
+    });
+    return result;
+  }
+  // ½Σρ over active residuals at the current values.
+  double cost() const { return evaluateCost(poses_, points_); }
+
+  SolverSummary solve(const SolverOptions& options = {}) {
+    prepare(options);
+    SolverSummary summary = levenbergMarquardt(*this, options);
+    summary.usedSparseSolver = system_.usesSparse();
+    return summary;
+  }
+
+  // ---- LinearizedModel interface (used by levenbergMarquardt) ----
+  bool hasFreeVariables() const { return !freePoseIds_.empty() || !freePointIds_.empty(); }
+  double linearize();
+  double maxGradient() const {
+    double g = 0.0;
+    if (poseRhs_.size() > 0) g = poseRhs_.cwiseAbs().maxCoeff();
+    for (const auto& b : pointRhs_) g = std::max(g, b.cwiseAbs().maxCoeff());
+    return g;
+  }
+  bool solveDamped(double mu, double& predictedDecrease, double& stepNorm);
+  double parameterNorm() const {
+    double sq = 0.0;
+    for (int p : freePoseIds_) sq += PoseM::squaredNorm(poses_[p]);
+    for (int l : freePointIds_) sq += points_[l].squaredNorm();
+    return std::sqrt(sq);
+  }
+  double candidateCost() {
+    for (std::size_t k = 0; k < freePoseIds_.size(); ++k) {
+      const int p = freePoseIds_[k];
+      candidatePoses_[p] = PoseM::plus(poses_[p], poseStep_.template segment<kPoseDim>(k * kPoseDim));
+    }
+    for (std::size_t k = 0; k < freePointIds_.size(); ++k) {
+      const int l = freePointIds_[k];
+      candidatePoints_[l] = points_[l] + pointStep_[k];
+    }
+    return evaluateCost(candidatePoses_, candidatePoints_);
+  }
+  void acceptCandidate() {
+    // Only free entries differ between the two arrays, so swapping keeps fixed values intact.
+    std::swap(poses_, candidatePoses_);
+    std::swap(points_, candidatePoints_);
+  }
+
+ private:
+  using PoseBlock = Eigen::Matrix<double, kPoseDim, kPoseDim>;
+  using CrossBlock = Eigen::Matrix<double, kPoseDim, 3>;
+  using PoseVector = Eigen::Matrix<double, kPoseDim, 1>;
+
+  // A (free pose, free point) observation inside the Schur complement.
+  struct Link {
+    int pose;  // free pose index
+    int term;
+    int index;
+  };
+
+  template <class R, std::size_t... I>
+  static constexpr int termOfImpl(std::index_sequence<I...>) {
+    int found = -1;
+    ((found < 0 && std::is_same_v<R, ResidualAt<I>> ? (found = static_cast<int>(I)) : 0), ...);
+    return found;
+  }
+  template <class R>
+  static constexpr int termOf() {
+    return termOfImpl<R>(std::index_sequence_for<Terms...>{});
+  }
+  template <class F>
+  static void forEachTerm(F&& f) {
+    [&]<std::size_t... I>(std::index_sequence<I...>) {
+      (f.template operator()<I>(), ...);
+    }(std::index_sequence_for<Terms...>{});
+  }
+  template <class F>
+  void visitTerm(int term, F&& f) {
+    forEachTerm([&]<std::size_t I>() { if (static_cast<int>(I) == term) f(std::get<I>(records_)); });
+  }
+  template <class F>
+  void visitTerm(int term, F&& f) const {
+    forEachTerm([&]<std::size_t I>() { if (static_cast<int>(I) == term) f(std::get<I>(records_)); });
+  }
+
+  template <class R>
+  static ResidualVector<R> rawResidual(const ResidualRecord<R>& rec, const AlignedVector<Pose>& poses,
+                                       const AlignedVector<Eigen::Vector3d>& points) {
+    ResidualVector<R> r;
+    if constexpr (PointResidual<R>) {
+      rec.residual.evaluate(poses[rec.pose], points[rec.other], r, nullptr, nullptr);
+    } else {
+      rec.residual.evaluate(poses[rec.pose], poses[rec.other], r, nullptr, nullptr);
+    }
+    return r;
+  }
+
+  double evaluateCost(const AlignedVector<Pose>& poses,
+                      const AlignedVector<Eigen::Vector3d>& points) const {
+    double cost = 0.0;
+    forEachTerm([&]<std::size_t I>() {
+      using Kernel = typename TermAt<I>::Kernel;
+      for (const auto& rec : std::get<I>(records_)) {
+        if (!rec.active) continue;
+        const double s = rec.information * rawResidual(rec, poses, points).squaredNorm();
+        cost += 0.5 * Kernel::evaluate(s, rec.delta2).rho;
+      }
+    });
+    return cost;
+  }
+
+  // Whitens r and the Jacobians, then applies the robust correction of Triggs et al. (as in
+  // Ceres' Corrector) so that the Gauss–Newton model matches ρ to second order.
+  template <int R, class... Jacobians>
+  static void whitenAndCorrect(double information, const KernelValue& k, double s,
+                               Eigen::Matrix<double, R, 1>& r, Jacobians*... jacobians) {
+    const double sqrtInfo = std::sqrt(information);
+    r *= sqrtInfo;
+    const double sqrtRho1 = std::sqrt(k.rho1);
+    double residualScale = sqrtRho1;
+    double alphaOverS = 0.0;
+    if (s > 0.0 && k.rho2 > 0.0) {
+      const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * k.rho2 / k.rho1);
+      residualScale = sqrtRho1 / (1.0 - alpha);
+      alphaOverS = alpha / s;
+    }
+    auto correct = [&](auto* jac) {
+      if (!jac) return;
+      *jac *= sqrtInfo;
+      if (alphaOverS != 0.0) {
+        *jac = sqrtRho1 * (*jac - alphaOverS * r * (r.transpose() * *jac));
+      } else {
+        *jac *= sqrtRho1;
+      }
+    };
+    (correct(jacobians), ...);
+    r *= residualScale;
+  }
+
+  void prepare(const SolverOptions& options);
+
+  AlignedVector<Pose> poses_;
+  std::vector<char> poseFixed_;
+  AlignedVector<Eigen::Vector3d> points_;
+  std::vector<char> pointFixed_;
+  std::tuple<AlignedVector<ResidualRecord<typename Terms::Residual>>...> records_;
+
+  // ---- solver state, rebuilt by prepare() ----
+  std::vector<int> freePose_, freePoseIds_, freePoint_, freePointIds_;
+  std::vector<int> linkStart_;  // per free point, into links_
+  std::vector<Link> links_;
+  std::array<std::vector<int>, kNumTerms> linkOfRecord_;
+  std::vector<BlockSlot> pairSlots_;  // per point, upper-triangular pairs of its links
+  std::vector<int> pairStart_;
+  std::array<std::vector<BlockSlot>, kNumTerms> edgeSlot_;  // pose-graph cross blocks
+  std::array<AlignedVector<PoseBlock>, kNumTerms> edgeCross_;
+  ReducedCameraSystem system_;
+  AlignedVector<PoseBlock> poseHessian_;
+  Eigen::VectorXd poseRhs_, poseStep_, poseDiagonal_;
+  AlignedVector<Eigen::Matrix3d> pointHessian_, pointInverse_;
+  AlignedVector<Eigen::Vector3d> pointRhs_, pointStep_, pointDiagonal_;
+  AlignedVector<CrossBlock> cross_, crossTimesInverse_;
+  AlignedVector<Pose> candidatePoses_;
+  AlignedVector<Eigen::Vector3d> candidatePoints_;
+  double minDiagonal_ = 1e-6, maxDiagonal_ = 1e32;
+};
+
+}  // namespace orbis::optim
+
+#include "orbis/optim/problem_impl.hpp"

@@ -1,0 +1,70 @@
+// A synthetic SE(3) pose graph: a ring of poses with drifting odometry and one loop edge; the
+// optimiser must close the loop.
+#include "orbis/optim/pose_graph_residuals.hpp"
+#include "orbis/optim/problem.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace orbis::optim {
+namespace {
+
+// Poses (camera-from-world) around a circle of radius 5 m, looking at its centre.
+std::vector<SE3d> ring(int n) {
+  std::vector<SE3d> poses;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2.0 * M_PI * k / n;
+    SE3d::Tangent xi = SE3d::Tangent::Zero();
+    xi[4] = a;
+    const SE3d worldFromCamera(SO3d::exp(xi.tail<3>()), Eigen::Vector3d(5 * std::sin(a), 0.1 * k, -5 * std::cos(a)));
+    poses.push_back(worldFromCamera.inverse());
+  }
+  return poses;
+}
+
+TEST(OptimPoseGraph, SE3LoopIsClosed) {
+  const int n = 24;
+  const auto truth = ring(n);
+  std::mt19937 rng(17);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  Problem<SE3Manifold, Term<RelativePoseSE3>> problem;
+  // Start from dead reckoning with biased, noisy odometry: the error accumulates around the ring.
+  SE3d current = truth[0];
+  problem.addPose(current, /*fixed=*/true);
+  for (int k = 1; k < n; ++k) {
+    const SE3d odometry = truth[k - 1] * truth[k].inverse();  // T_{k-1,k} = T_{k-1,w} T_{k,w}⁻¹
+    SE3d::Tangent bias;
+    for (int c = 0; c < 6; ++c) bias[c] = noise(rng) + 0.01;
+    const SE3d measured = SE3d::exp(bias) * odometry;
+    current = measured.inverse() * current;  // T_{k,w} = T_{k-1,k}⁻¹ T_{k-1,w}
+    problem.addPose(current);
+    problem.add(RelativePoseSE3{measured}, k - 1, k);
+  }
+  const SE3d loop = truth[n - 1] * truth[0].inverse();
+  const ResidualId loopEdge = problem.add(RelativePoseSE3{loop}, n - 1, 0, /*information=*/100.0);
+
+  auto worstError = [&] {
+    double worst = 0.0;
+    for (int k = 0; k < n; ++k) {
+      worst = std::max(worst, (problem.pose(k).inverse().translation() - truth[k].inverse().translation()).norm());
+    }
+    return worst;
+  };
+  const double loopBefore = std::sqrt(problem.chi2(loopEdge) / 100.0);
+  const double errorBefore = worstError();
+  const SolverSummary summary = problem.solve();
+  const double loopAfter = std::sqrt(problem.chi2(loopEdge) / 100.0);
+  const double errorAfter = worstError();
+  std::printf("SE3 ring of %d: loop residual %.4f -> %.4f, worst position error %.3f -> %.3f m, "
+              "cost %.4g -> %.4g in %d iterations\n", n, loopBefore, loopAfter, errorBefore,
+              errorAfter, summary.initialCost, summary.finalCost, summary.iterations);
+  EXPECT_TRUE(summary.converged());
+  EXPECT_GT(loopBefore, 0.3);
+  EXPECT_LT(loopAfter, 0.05 * loopBefore);
+  EXPECT_LT(errorAfter, 0.3 * errorBefore);
+}
+
+}  // namespace
+}  // namespace orbis::optim

@@ -1,0 +1,95 @@
+// Every residual's analytic Jacobians against central differences (through its manifold's
+// update), on random well-conditioned configurations. The maximum discrepancy is printed.
+#include "jacobian_check.hpp"
+
+#include "orbis/optim/pose_graph_residuals.hpp"
+#include "orbis/optim/reprojection.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace orbis::optim {
+namespace {
+
+SE3d randomPose(std::mt19937& rng, double rotation, double translation) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  SE3d::Tangent xi;
+  for (int k = 0; k < 3; ++k) xi[k] = translation * n(rng);
+  for (int k = 3; k < 6; ++k) xi[k] = rotation * n(rng);
+  return SE3d::exp(xi);
+}
+
+// A world point in front of the camera at distance 2–10 m.
+Eigen::Vector3d pointInFront(std::mt19937& rng, const SE3d& cameraFromWorld) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::Vector3d pc(u(rng), u(rng), 6.0 + 4.0 * u(rng));
+  return cameraFromWorld.inverse() * pc;
+}
+
+template <class R>
+double worstOverTrials(std::uint32_t seed, const typename R::Observation& measurement,
+                       const typename std::remove_pointer_t<decltype(R::camera)>& camera) {
+  std::mt19937 rng(seed);
+  double worst = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const SE3d pose = randomPose(rng, 0.8, 1.0);
+    const R residual{measurement, &camera};
+    const auto d = test::checkJacobians(residual, pose, pointInFront(rng, pose));
+    worst = std::max(worst, d.relative());
+  }
+  return worst;
+}
+
+TEST(OptimResiduals, MonoReprojectionJacobians) {
+  const PinholeCamera<double> camera{458.0, 457.0, 367.0, 248.0, 752, 480};
+  const double worst = worstOverTrials<MonoReprojection>(1, {300.0, 200.0}, camera);
+  std::printf("MonoReprojection (2x6x3): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(OptimResiduals, StereoReprojectionJacobians) {
+  const RectifiedStereoCamera<double> camera({718.9, 718.9, 607.2, 185.2, 1226, 370}, 0.537);
+  const double worst = worstOverTrials<StereoReprojection>(2, {300.0, 200.0, 250.0}, camera);
+  std::printf("StereoReprojection (3x6x3): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(OptimResiduals, RgbdReprojectionJacobians) {
+  const RgbdCamera<double> camera({535.4, 539.2, 320.1, 247.6, 640, 480}, 40.0 / 535.4, 5000.0);
+  const double worst = worstOverTrials<RgbdReprojection>(3, {310.0, 240.0, 290.0}, camera);
+  std::printf("RgbdReprojection (3x6x3): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(OptimResiduals, RelativePoseSE3Jacobians) {
+  std::mt19937 rng(4);
+  double worst = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    // Far from satisfied (large residual) so the J_l⁻¹/J_r⁻¹ factors matter.
+    const RelativePoseSE3 residual{randomPose(rng, 0.7, 1.0)};
+    const auto d = test::checkJacobians(residual, randomPose(rng, 0.7, 2.0), randomPose(rng, 0.7, 2.0));
+    worst = std::max(worst, d.relative());
+  }
+  std::printf("RelativePoseSE3 (6x6x6): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(OptimResiduals, JacobianCheckDetectsAWrongJacobian) {
+  // The harness itself must be able to fail: a residual with a deliberately wrong sign.
+  struct Wrong : MonoReprojection {
+    void evaluate(const SE3d& t, const Eigen::Vector3d& x, Eigen::Vector2d& r,
+                  Eigen::Matrix<double, 2, 6>* jp, Eigen::Matrix<double, 2, 3>* jx) const {
+      MonoReprojection::evaluate(t, x, r, jp, jx);
+      if (jp) jp->rightCols<3>() *= -1.0;
+    }
+  };
+  const PinholeCamera<double> camera{458.0, 457.0, 367.0, 248.0, 752, 480};
+  std::mt19937 rng(5);
+  const SE3d pose = randomPose(rng, 0.5, 1.0);
+  const Wrong wrong{{{300.0, 200.0}, &camera}};
+  EXPECT_GT(test::checkJacobians(wrong, pose, pointInFront(rng, pose)).relative(), 1e-2);
+}
+
+}  // namespace
+}  // namespace orbis::optim
