@@ -18,7 +18,7 @@ std::string typeName(const cv::FileNode& n) {
 
 // OpenCV reports parse errors as "... in function '<file>(<line>): <problem>'".
 Error parseError(const std::string& path, const cv::Exception& e) {
-  static const std::regex located(R"(\((\d+)\): ([^']*))");
+  static const std::regex located(R"(\((\d+)\): (.*)')");
   std::smatch m;
   if (std::regex_search(e.msg, m, located)) {
     return lineError(path, std::stoul(m[1].str()), "not valid YAML: " + m[2].str());
@@ -31,6 +31,7 @@ Error parseError(const std::string& path, const cv::Exception& e) {
 YamlReader::YamlReader(const std::filesystem::path& path) : path_(path.string()) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path_, "no such file");
+  if (std::filesystem::file_size(path, ec) == 0) throw fileError(path_, "empty file, expected OpenCV YAML (%YAML:1.0)");
   try {
     if (!storage_.open(path_, cv::FileStorage::READ)) throw fileError(path_, "cannot be opened for reading");
   } catch (const cv::Exception& e) {
@@ -98,25 +99,32 @@ std::vector<double> YamlReader::reals(const std::string& key, std::size_t minCou
   return values;
 }
 
-Eigen::MatrixXd YamlReader::matrix(const std::string& key, int rows, int cols) const {
+Eigen::MatrixXd YamlReader::matrix(const std::string& key) const {
   const cv::FileNode n = node(key);
-  if (!n.isMap()) throw error(key, "expected a matrix (a map with rows, cols and data), found " + typeName(n));
-  const std::string size = std::to_string(rows) + "x" + std::to_string(cols);
-  if (n["rows"].empty() || n["cols"].empty() || n["data"].empty()) {
-    throw error(key, "expected a " + size + " matrix with rows, cols and data");
+  if (!n.isMap() || n["rows"].empty() || n["cols"].empty() || n["data"].empty()) {
+    throw error(key, "expected a matrix (a map with rows, cols and data), found " + typeName(n));
   }
-  if (wholeNumber(n["rows"], key + ".rows") != rows || wholeNumber(n["cols"], key + ".cols") != cols) {
-    throw error(key, "expected a " + size + " matrix");
-  }
+  const int rows = wholeNumber(n["rows"], key + ".rows");
+  const int cols = wholeNumber(n["cols"], key + ".cols");
+  if (rows <= 0 || cols <= 0 || rows > 64 || cols > 64) throw error(key, "expected 1 to 64 rows and columns");
   const cv::FileNode data = n["data"];
   if (!data.isSeq() || static_cast<int>(data.size()) != rows * cols) {
-    throw error(key + ".data", "expected " + std::to_string(rows * cols) + " numbers");
+    throw error(key + ".data", "expected " + std::to_string(rows * cols) + " numbers (rows x cols)");
   }
   Eigen::MatrixXd m(rows, cols);
   int i = 0;
   for (const cv::FileNode& item : data) {
     m(i / cols, i % cols) = number(item, key + ".data");
     ++i;
+  }
+  return m;
+}
+
+Eigen::MatrixXd YamlReader::matrix(const std::string& key, int rows, int cols) const {
+  Eigen::MatrixXd m = matrix(key);
+  if (m.rows() != rows || m.cols() != cols) {
+    throw error(key, "expected a " + std::to_string(rows) + "x" + std::to_string(cols) + " matrix, found " +
+                         std::to_string(m.rows()) + "x" + std::to_string(m.cols()));
   }
   return m;
 }

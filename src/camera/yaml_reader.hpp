@@ -35,7 +35,9 @@ class YamlReader {
   std::optional<std::string> optionalString(const std::string& key) const;
   // A YAML sequence of numbers whose length lies in [minCount, maxCount].
   std::vector<double> reals(const std::string& key, std::size_t minCount, std::size_t maxCount) const;
-  // An !!opencv-matrix, or any map with rows, cols and data (EuRoC's T_BS), of the given size.
+  // An !!opencv-matrix, or any map with rows, cols and data (EuRoC's T_BS), of any size ...
+  Eigen::MatrixXd matrix(const std::string& key) const;
+  // ... or of exactly the given size.
   Eigen::MatrixXd matrix(const std::string& key, int rows, int cols) const;
 
  private:
