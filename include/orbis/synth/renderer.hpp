@@ -1,0 +1,59 @@
+// orbis/synth/renderer.hpp — a ray caster that renders grey images and depth of a Scene.
+//
+// Contract: render() draws what an ideal pinhole camera at pose cameraToWorld (T_wc) sees of
+// the scene. Pixel (i, j) is centred on image coordinates (u, v) = (i, j), the convention of
+// PinholeCamera::project, and its grey value is the mean of supersample x supersample rays on a
+// regular grid inside the pixel, each sampling its texture trilinearly at the mip level of the
+// ray spacing (antialiasing of both silhouettes and texture). gray: CV_32FC1, grey levels
+// 0..255. depth (when asked): CV_32FC1, metres along the optical axis of the ray through the
+// pixel centre, 0 where no surface is hit. Per frame, rectangles facing away are culled and
+// the rest are binned into 16x16-pixel tiles by their clipped projected bounds, so each ray
+// tests only the few rectangles that can cover it. A Renderer keeps scratch buffers: use one
+// per thread. `threads` > 1 splits the rows among that many threads; the result is identical.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/geometry/se3.hpp"
+#include "orbis/synth/scene.hpp"
+
+namespace orbis::synth {
+
+struct RenderOptions {
+  int supersample = 2;   // rays per pixel along each axis
+  double lodBias = 0.0;  // added to every mip level (positive: blurrier)
+  int threads = 1;
+};
+
+class Renderer {
+ public:
+  explicit Renderer(RenderOptions options = {}) : options_(options) {}
+
+  void render(const Scene& scene, const PinholeCamera<double>& camera, const SE3d& cameraToWorld,
+              cv::Mat& gray, cv::Mat* depth = nullptr);
+
+  const RenderOptions& options() const { return options_; }
+
+  // One rectangle as the hot loop sees it in the current frame.
+  struct FrameRect {
+    int axis, u, v;
+    double offset, lo0, lo1, hi0, hi1, invTexel, lodScale;
+    const Texture* texture;
+  };
+
+ private:
+  void binRects(const Scene& scene, const PinholeCamera<double>& camera, const SE3d& cameraToWorld);
+  void renderRows(const PinholeCamera<double>& camera, const SE3d& cameraToWorld, int rowBegin, int rowEnd,
+                  cv::Mat& gray, cv::Mat* depth) const;
+
+  RenderOptions options_;
+  std::vector<FrameRect> frameRects_;
+  int tilesX_ = 0, tilesY_ = 0;
+  std::vector<int> tileBegin_;     // tile t's rectangles: tileRects_[tileBegin_[t] .. tileBegin_[t+1])
+  std::vector<int> tileRects_;
+};
+
+}  // namespace orbis::synth

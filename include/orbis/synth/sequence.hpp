@@ -1,0 +1,85 @@
+// orbis/synth/sequence.hpp — synthetic image sequences with exact ground truth.
+//
+// Contract: a SyntheticSequence renders frame i of the room scene (makeRoomScene) seen along
+// one loop of loopPose(): frame i has phase i / frames, timestamp startTime + i / fps (held
+// as integer nanoseconds, so every dataset layout writes the same instants), and ground truth
+// pose(i) = T_wc of the left camera. The right camera of the rectified stereo pair sits at
+// +baseline along the left camera's x axis with the same orientation and intrinsics; depth is
+// metric along the left optical axis. Images are CV_8UC1: the rendered grey levels, averaged
+// over blurSubframes renders spread over `shutter` of the frame interval centred on the
+// frame's instant (motion blur), plus Gaussian noise of noiseSigma grey levels, rounded and
+// clamped. Frames blackStart .. blackStart+blackCount-1 are all black with zero (invalid)
+// depth, but keep their pose (the camera was covered). Everything is a function of the
+// options and the seed: the same options give byte-identical frames, in any order, and
+// render() is const apart from the scratch buffers of the per-object renderer.
+#pragma once
+
+#include <cstdint>
+
+#include <opencv2/core.hpp>
+
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/geometry/se3.hpp"
+#include "orbis/synth/loop_trajectory.hpp"
+#include "orbis/synth/renderer.hpp"
+#include "orbis/synth/scene.hpp"
+
+namespace orbis::synth {
+
+struct SynthOptions {
+  int frames = 300;
+  int width = 640, height = 480;
+  double fx = 500.0;             // fy = fx; principal point at the image centre
+  double baseline = 0.1;         // metres, right camera at +baseline along x
+  double fps = 30.0;
+  double startTime = 1.0;        // seconds, timestamp of frame 0
+  double noiseSigma = 0.0;       // grey levels
+  int blurSubframes = 1;         // 1: no motion blur
+  double shutter = 0.5;          // fraction of the frame interval the shutter is open
+  int blackStart = -1, blackCount = 0;
+  std::uint64_t seed = 1;
+  int supersample = 2;
+  int threads = 1;
+  RoomParams room;
+  LoopTrajectoryParams path;
+};
+
+struct SynthFrame {
+  int index = 0;
+  std::int64_t timestampNs = 0;
+  SE3d pose;        // T_wc of the left camera
+  bool black = false;
+  cv::Mat left;     // CV_8UC1
+  cv::Mat right;    // CV_8UC1, when asked
+  cv::Mat depth;    // CV_32FC1 metres (0 = invalid), when asked
+};
+
+class SyntheticSequence {
+ public:
+  // Throws orbis::Error("synth options", key, ...) for a non-positive size, frame count, fps,
+  // focal length or baseline, or a negative noise or black segment.
+  explicit SyntheticSequence(const SynthOptions& options);
+
+  const SynthOptions& options() const { return options_; }
+  const Scene& scene() const { return scene_; }
+  PinholeCamera<double> camera() const;
+  int size() const { return options_.frames; }
+
+  std::int64_t timestampNs(int i) const;
+  double timestamp(int i) const { return static_cast<double>(timestampNs(i)) * 1e-9; }
+  SE3d pose(int i) const;               // T_wc, left camera
+  SE3d rightPose(int i) const;          // T_wc, right camera
+  bool isBlack(int i) const;
+
+  SynthFrame render(int i, bool withRight, bool withDepth);
+
+ private:
+  SE3d poseAtPhase(double phase) const { return loopPose(options_.path, phase); }
+  cv::Mat renderImage(int i, const SE3d& leftToRight, int cameraIndex, cv::Mat* depth);
+
+  SynthOptions options_;
+  Scene scene_;
+  Renderer renderer_;
+};
+
+}  // namespace orbis::synth

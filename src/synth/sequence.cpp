@@ -1,0 +1,112 @@
+#include "orbis/synth/sequence.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "orbis/synth/rng.hpp"
+#include "orbis/util/error.hpp"
+
+namespace orbis::synth {
+
+namespace {
+
+void require(bool ok, const std::string& key, const std::string& what) {
+  if (!ok) throw keyError("synth options", key, what);
+}
+
+}  // namespace
+
+SyntheticSequence::SyntheticSequence(const SynthOptions& options)
+    : options_(options), renderer_(RenderOptions{options.supersample, 0.0, options.threads}) {
+  require(options.frames > 0, "frames", "must be positive");
+  require(options.width > 0 && options.height > 0, "resolution", "width and height must be positive");
+  require(options.fx > 0.0, "fx", "must be positive");
+  require(options.baseline > 0.0, "baseline", "must be positive (metres)");
+  require(options.fps > 0.0, "fps", "must be positive");
+  require(options.noiseSigma >= 0.0, "noise", "must not be negative");
+  require(options.blurSubframes >= 1, "blur", "must be at least 1 sub-frame");
+  require(options.shutter >= 0.0 && options.shutter <= 1.0, "shutter", "must lie in [0, 1]");
+  require(options.blackCount >= 0, "black", "count must not be negative");
+  require(options.blackCount == 0 || options.blackStart >= 0, "black", "start must not be negative");
+  require(options.supersample >= 1, "supersample", "must be at least 1");
+  scene_ = makeRoomScene(options.room, options.seed);
+}
+
+PinholeCamera<double> SyntheticSequence::camera() const {
+  PinholeCamera<double> c;
+  c.fx = c.fy = options_.fx;
+  c.cx = 0.5 * options_.width;
+  c.cy = 0.5 * options_.height;
+  c.width = options_.width;
+  c.height = options_.height;
+  return c;
+}
+
+std::int64_t SyntheticSequence::timestampNs(int i) const {
+  return std::llround(options_.startTime * 1e9) + std::llround(i * 1e9 / options_.fps);
+}
+
+SE3d SyntheticSequence::pose(int i) const { return poseAtPhase(static_cast<double>(i) / options_.frames); }
+
+SE3d SyntheticSequence::rightPose(int i) const {
+  return pose(i) * SE3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(options_.baseline, 0.0, 0.0));
+}
+
+bool SyntheticSequence::isBlack(int i) const {
+  return options_.blackCount > 0 && i >= options_.blackStart && i < options_.blackStart + options_.blackCount;
+}
+
+cv::Mat SyntheticSequence::renderImage(int i, const SE3d& leftToCamera, int cameraIndex, cv::Mat* depth) {
+  const PinholeCamera<double> cam = camera();
+  const int n = options_.blurSubframes;
+  cv::Mat sum, gray;
+  for (int k = 0; k < n; ++k) {
+    // Sub-frame instants spread evenly over the open shutter, centred on the frame's instant.
+    const double offset = n == 1 ? 0.0 : options_.shutter * ((k + 0.5) / n - 0.5);
+    const SE3d subPose = poseAtPhase((i + offset) / options_.frames) * leftToCamera;
+    // Depth belongs to the frame's instant, i.e. the central sub-frame (or the one just past it).
+    const bool centre = k == n / 2;
+    renderer_.render(scene_, cam, subPose, gray, centre ? depth : nullptr);
+    if (k == 0) sum = gray.clone();
+    else sum += gray;
+  }
+  if (n > 1) sum *= 1.0 / n;
+  if (depth && n > 1 && n % 2 == 0) {
+    // Even sub-frame counts have no sample at the frame's instant: render its depth separately.
+    renderer_.render(scene_, cam, pose(i) * leftToCamera, gray, depth);
+  }
+  cv::Mat out(cam.height, cam.width, CV_8UC1);
+  SynthRng rng(mixSeed(options_.seed, static_cast<std::uint64_t>(i) + 1, static_cast<std::uint64_t>(cameraIndex) + 1));
+  const double sigma = options_.noiseSigma;
+  for (int y = 0; y < out.rows; ++y) {
+    const float* s = sum.ptr<float>(y);
+    std::uint8_t* o = out.ptr<std::uint8_t>(y);
+    for (int x = 0; x < out.cols; ++x) {
+      const double v = s[x] + (sigma > 0.0 ? sigma * rng.normal() : 0.0);
+      o[x] = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+    }
+  }
+  return out;
+}
+
+SynthFrame SyntheticSequence::render(int i, bool withRight, bool withDepth) {
+  SynthFrame f;
+  f.index = i;
+  f.timestampNs = timestampNs(i);
+  f.pose = pose(i);
+  f.black = isBlack(i);
+  const cv::Size size(options_.width, options_.height);
+  if (f.black) {
+    f.left = cv::Mat::zeros(size, CV_8UC1);
+    if (withRight) f.right = cv::Mat::zeros(size, CV_8UC1);
+    if (withDepth) f.depth = cv::Mat::zeros(size, CV_32FC1);
+    return f;
+  }
+  f.left = renderImage(i, SE3d(), 0, withDepth ? &f.depth : nullptr);
+  if (withRight)
+    f.right = renderImage(i, SE3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(options_.baseline, 0.0, 0.0)), 1, nullptr);
+  return f;
+}
+
+}  // namespace orbis::synth
