@@ -20,9 +20,9 @@
 #include <variant>
 
 #include "orbis/camera/distortion.hpp"
-#include "orbis/camera/sensor_kind.hpp"
 #include "orbis/camera/pinhole.hpp"
 #include "orbis/camera/rectification.hpp"
+#include "orbis/camera/sensor_kind.hpp"
 #include "orbis/camera/stereo.hpp"
 #include "orbis/features/orb_params.hpp"
 
