@@ -1,0 +1,75 @@
+// orbis/io/trajectory.hpp — stamped camera trajectories and their three file formats.
+//
+// Contract: a Trajectory is a time-ordered list of camera-to-world poses (T_wc, so
+// pose.translation() is the camera centre in world coordinates), timestamps in seconds.
+// Readers accept the benchmarks' own layouts:
+//   TUM    "t tx ty tz qx qy qz qw" (whitespace separated, '#' comments);
+//   KITTI  12 numbers per line, the 3x4 matrix [R|t] row-major; timestamps come from a
+//          times file (one number per line, same count) or are the frame index 0,1,2,...;
+//   EuRoC  csv "t_ns, px, py, pz, qw, qx, qy, qz[, ignored columns...]", '#' header.
+// Quaternions are normalised on reading, rotation matrices re-orthonormalised. A malformed
+// line, a non-finite number, a zero quaternion or a timestamp not strictly after the previous
+// one throws orbis::Error naming the file and the line. Writers throw orbis::Error naming the
+// path when it cannot be written. Timestamps are doubles: EuRoC nanoseconds survive a round
+// trip to within ~0.3 microseconds at present-day epochs.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "orbis/geometry/se3.hpp"
+
+namespace orbis {
+
+struct StampedPose {
+  double t = 0.0;  // seconds
+  SE3d pose;       // camera-to-world
+};
+using Trajectory = std::vector<StampedPose>;
+
+enum class TrajectoryFormat { Tum, Kitti, Euroc };
+
+// "tum", "kitti" or "euroc"; throws orbis::Error(source) for anything else.
+TrajectoryFormat parseTrajectoryFormat(std::string_view name, const std::string& source = "format");
+std::string_view toString(TrajectoryFormat format);
+
+// Guesses from the extension (.csv → EuRoC) and else from the first data row's column count
+// (8 → TUM, 12 → KITTI). Throws orbis::Error naming the file when it cannot tell.
+TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& file);
+
+// kittiTimesFile is used only for TrajectoryFormat::Kitti; empty means "frame index".
+Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat format,
+                          const std::filesystem::path& kittiTimesFile = {});
+// Reads a KITTI times.txt-style file: one timestamp per line, strictly increasing.
+std::vector<double> readTimestamps(const std::filesystem::path& file);
+
+void writeTrajectory(const std::filesystem::path& file, const Trajectory& trajectory,
+                     TrajectoryFormat format);
+
+// One-to-one association of two increasing timestamp lists, nearest pairs first, within maxDt
+// seconds (inclusive), as the TUM benchmark's associate.py does. Returns (index in a, index in
+// b) pairs ordered by the index in a.
+std::vector<std::pair<std::size_t, std::size_t>> associateTimestamps(const std::vector<double>& a,
+                                                                     const std::vector<double>& b,
+                                                                     double maxDt);
+
+// ---- Text tables, shared with the dataset adapters ------------------------------------------
+// One data row of a text table: its 1-based line number and its fields (split on whitespace
+// and commas; blank lines and lines starting with '#' are skipped). The views die with the row.
+struct TextRow {
+  std::size_t line = 0;
+  std::span<const std::string_view> fields;
+};
+// Calls visit for every data row of file; throws orbis::Error when the file cannot be opened.
+void forEachTextRow(const std::filesystem::path& file, const std::function<void(const TextRow&)>& visit);
+// Parses a field as a finite double / an integer; throws orbis::Error naming file and line.
+double parseDouble(std::string_view field, const std::filesystem::path& file, std::size_t line);
+long long parseInteger(std::string_view field, const std::filesystem::path& file, std::size_t line);
+
+}  // namespace orbis

@@ -1,0 +1,136 @@
+// Trajectory I/O: round trips through every format, and errors that name file and line.
+#include "orbis/io/trajectory.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+#include "orbis/util/error.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using orbis::Trajectory;
+using orbis::TrajectoryFormat;
+
+class TrajectoryIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("orbis_traj_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  fs::path dir_;
+};
+
+Trajectory randomTrajectory(std::size_t n, unsigned seed, double t0) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Trajectory traj;
+  for (std::size_t i = 0; i < n; ++i) {
+    orbis::SE3d::Tangent xi;
+    for (int k = 0; k < 6; ++k) xi[k] = normal(rng);
+    traj.push_back({t0 + 0.05 * static_cast<double>(i) + 0.001 * std::abs(normal(rng)),
+                    orbis::SE3d::exp(xi)});
+  }
+  return traj;
+}
+
+void expectSamePoses(const Trajectory& a, const Trajectory& b, double timeTolerance) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(a[i].t, b[i].t, timeTolerance) << "pose " << i;
+    EXPECT_LT((a[i].pose.matrix() - b[i].pose.matrix()).cwiseAbs().maxCoeff(), 1e-7) << "pose " << i;
+  }
+}
+
+TEST_F(TrajectoryIoTest, TumAndEurocRoundTrip) {
+  // Present-day epochs, where a double keeps ~0.2 microseconds.
+  for (const auto& [format, name, t0] : {std::tuple{TrajectoryFormat::Tum, "traj.txt", 1305031102.160407},
+                                         std::tuple{TrajectoryFormat::Euroc, "traj.csv", 1403715273.262142976}}) {
+    const Trajectory original = randomTrajectory(50, format == TrajectoryFormat::Tum ? 1 : 2, t0);
+    const fs::path p = dir_ / name;
+    orbis::writeTrajectory(p, original, format);
+    EXPECT_EQ(orbis::detectTrajectoryFormat(p), format);
+    expectSamePoses(original, orbis::readTrajectory(p, format), 1e-6);
+  }
+}
+
+TEST_F(TrajectoryIoTest, KittiRoundTripWithAndWithoutTimes) {
+  const Trajectory original = randomTrajectory(30, 3, 0.0);
+  const fs::path p = dir_ / "poses.txt";
+  orbis::writeTrajectory(p, original, TrajectoryFormat::Kitti);
+  EXPECT_EQ(orbis::detectTrajectoryFormat(p), TrajectoryFormat::Kitti);
+  const Trajectory byIndex = orbis::readTrajectory(p, TrajectoryFormat::Kitti);
+  ASSERT_EQ(byIndex.size(), original.size());
+  for (std::size_t i = 0; i < byIndex.size(); ++i) EXPECT_EQ(byIndex[i].t, static_cast<double>(i));
+
+  std::string times;
+  for (const auto& sp : original) times += std::to_string(sp.t) + "\n";
+  const fs::path timesFile = write("times.txt", times);
+  expectSamePoses(original, orbis::readTrajectory(p, TrajectoryFormat::Kitti, timesFile), 1e-6);
+}
+
+TEST_F(TrajectoryIoTest, ReadsEurocGroundTruthWithExtraColumnsAndNormalisesQuaternions) {
+  const fs::path p = write("gt.csv",
+                           "#time(ns),px,py,pz,qw,qx,qy,qz,vx,vy,vz\n"
+                           "1403715273262142976,1,2,3,2,0,0,0,9,9,9\n"
+                           "1403715273312143104, 4, 5, 6, 0, 0, 0, 3\n");
+  const Trajectory traj = orbis::readTrajectory(p, TrajectoryFormat::Euroc);
+  ASSERT_EQ(traj.size(), 2u);
+  EXPECT_NEAR(traj[1].t - traj[0].t, 0.050000128, 1e-6);
+  EXPECT_TRUE(traj[0].pose.rotationMatrix().isIdentity(1e-12));
+  EXPECT_NEAR(traj[1].pose.so3().unitQuaternion().z(), 1.0, 1e-12);  // qz=3 normalised
+  EXPECT_EQ(traj[1].pose.translation(), Eigen::Vector3d(4, 5, 6));
+}
+
+// Every malformed input names the file and the offending line.
+void expectLineError(const fs::path& p, TrajectoryFormat format, std::size_t line) {
+  try {
+    orbis::readTrajectory(p, format);
+    ADD_FAILURE() << "no error for " << p;
+  } catch (const orbis::Error& e) {
+    EXPECT_EQ(e.source(), p.string());
+    EXPECT_EQ(e.where(), "line " + std::to_string(line)) << e.what();
+  }
+}
+
+TEST_F(TrajectoryIoTest, MalformedLinesNameFileAndLine) {
+  expectLineError(write("short.txt", "# header\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n"), TrajectoryFormat::Tum, 3);
+  expectLineError(write("word.txt", "1 0 0 0 0 0 0 1\n\n2 0 zero 0 0 0 0 1\n"), TrajectoryFormat::Tum, 3);
+  expectLineError(write("nan.txt", "1 0 0 nan 0 0 0 1\n"), TrajectoryFormat::Tum, 1);
+  expectLineError(write("zeroq.txt", "1 0 0 0 0 0 0 0\n"), TrajectoryFormat::Tum, 1);
+  expectLineError(write("order.txt", "2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n"), TrajectoryFormat::Tum, 2);
+  expectLineError(write("bad.csv", "#h\n100,1,2,3,1,0,0,0\n200,1,2,3,1,0,0\n"), TrajectoryFormat::Euroc, 3);
+  expectLineError(write("float.csv", "1.5e9,1,2,3,1,0,0,0\n"), TrajectoryFormat::Euroc, 1);
+  expectLineError(write("k.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n"), TrajectoryFormat::Kitti, 2);
+  expectLineError(write("notrot.txt", "2 0 0 0 0 2 0 0 0 0 2 0\n"), TrajectoryFormat::Kitti, 1);
+}
+
+TEST_F(TrajectoryIoTest, MissingFilesAndMismatchedTimesAreErrors) {
+  EXPECT_THROW(orbis::readTrajectory(dir_ / "absent.txt", TrajectoryFormat::Tum), orbis::Error);
+  const fs::path poses = write("poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
+  const fs::path times = write("times.txt", "0.0\n");
+  try {
+    orbis::readTrajectory(poses, TrajectoryFormat::Kitti, times);
+    ADD_FAILURE() << "no error for a times file of the wrong length";
+  } catch (const orbis::Error& e) {
+    EXPECT_EQ(e.source(), times.string());
+  }
+  EXPECT_THROW(orbis::writeTrajectory(dir_ / "no_such_dir" / "x.txt", {}, TrajectoryFormat::Tum),
+               orbis::Error);
+  EXPECT_THROW(orbis::parseTrajectoryFormat("ply"), orbis::Error);
+}
+
+}  // namespace
