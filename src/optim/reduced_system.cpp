@@ -89,7 +89,7 @@ void ReducedCameraSystem::setPattern(const BlockPatternBuilder& pattern, int blo
   if (sparse_) {
     cholmod_.analyze(dim, colStarts_, rowIndices_);
   } else {
-    dense_.resize(dim, dim);
+    dense_.setZero(dim, dim);  // entries outside the pattern are never written again
   }
 }
 

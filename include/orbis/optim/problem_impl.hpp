@@ -159,13 +159,13 @@ double Problem<PoseM, Terms...>::linearize() {
         whitenAndCorrect(rec.information, k, s, r, fp >= 0 ? &jPose : nullptr,
                          fl >= 0 ? &jPoint : nullptr);
         if (fp >= 0) {
-          poseHessian_[fp].noalias() += jPose.transpose() * jPose;
+          poseHessian_[fp].noalias() += jPose.transpose().lazyProduct(jPose);
           poseRhs_.template segment<D>(fp * D).noalias() -= jPose.transpose() * r;
         }
         if (fl >= 0) {
-          pointHessian_[fl].noalias() += jPoint.transpose() * jPoint;
+          pointHessian_[fl].noalias() += jPoint.transpose().lazyProduct(jPoint);
           pointRhs_[fl].noalias() -= jPoint.transpose() * r;
-          if (fp >= 0) cross_[linkOfRecord_[I][e]].noalias() = jPose.transpose() * jPoint;
+          if (fp >= 0) cross_[linkOfRecord_[I][e]].noalias() = jPose.transpose().lazyProduct(jPoint);
         }
       } else {
         int fi = freePose_[rec.pose], fj = freePose_[rec.other];
@@ -183,11 +183,11 @@ double Problem<PoseM, Terms...>::linearize() {
         whitenAndCorrect(rec.information, k, s, r, fi >= 0 ? &jPose : nullptr,
                          fj >= 0 ? &jOther : nullptr);
         if (fi >= 0) {
-          poseHessian_[fi].noalias() += jPose.transpose() * jPose;
+          poseHessian_[fi].noalias() += jPose.transpose().lazyProduct(jPose);
           poseRhs_.template segment<D>(fi * D).noalias() -= jPose.transpose() * r;
         }
         if (fj >= 0) {
-          poseHessian_[fj].noalias() += jOther.transpose() * jOther;
+          poseHessian_[fj].noalias() += jOther.transpose().lazyProduct(jOther);
           poseRhs_.template segment<D>(fj * D).noalias() -= jOther.transpose() * r;
         }
         if (fi >= 0 && fj >= 0) {
@@ -247,14 +247,15 @@ bool Problem<PoseM, Terms...>::solveDamped(double mu, double& predictedDecrease,
     const int first = linkStart_[l], last = linkStart_[l + 1];
     for (int a = first; a < last; ++a) {
       CrossBlock& y = crossTimesInverse_[a - first];
-      y.noalias() = cross_[a] * inverse;
+      y.noalias() = cross_[a].lazyProduct(inverse);
       rhs.template segment<D>(links_[a].pose * D).noalias() -= y * pointRhs_[l];
     }
     const BlockSlot* slot = pairSlots_.data() + pairStart_[l];
     for (int a = first; a < last; ++a) {
       const CrossBlock& y = crossTimesInverse_[a - first];
       for (int b = a; b < last; ++b, ++slot) {
-        const PoseBlock block = -(y * cross_[b].transpose());
+        // lazyProduct: Eigen would otherwise send these small fixed-size products to GEMM.
+        const PoseBlock block = -y.lazyProduct(cross_[b].transpose());
         if (a == b) {
           system_.template addDiagonal<D>(links_[a].pose, block);
         } else {
