@@ -1,5 +1,7 @@
 // EuRoC calibration reader and stereo rectification, checked on the real images: after
 // rectification ORB matches between left and right must lie on the same row.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -84,7 +86,7 @@ TEST(EurocCalibration, ReadsSensorYaml) {
 }
 
 TEST(EurocCalibration, MalformedFilesNameFileAndKey) {
-  const auto dir = std::filesystem::temp_directory_path() / "orbis_camera_euroc_test";
+  const auto dir = std::filesystem::temp_directory_path() / ("orbis_camera_euroc_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string good =
       "%YAML:1.0\nT_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"

@@ -1,5 +1,8 @@
 // ORB-SLAM2 settings: every shipped file loads into the right camera model, and malformed
 // files give an orbis::Error naming the file and the key (or line), never a crash.
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
