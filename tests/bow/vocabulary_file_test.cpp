@@ -181,3 +181,28 @@ TEST(VocabularyFile, ChecksumDependsOnEveryByte) {
 
 }  // namespace
 }  // namespace orbis::bow
+
+namespace orbis::bow {
+namespace {
+
+TEST(VocabularyFile, RandomCompleteTreeRoundTripsThroughBothFormats) {
+  TempDir dir;
+  const OrbVocabulary v = randomVocabulary<OrbDescriptor, HammingDistance>(4, 3, 9);
+  EXPECT_EQ(v.wordCount(), 64u);
+  EXPECT_EQ(v.nodeCount(), 85u);
+  writeDbow2Text(v, dir.path / "r.txt");
+  const OrbVocabulary t = readDbow2Text<OrbVocabulary>(dir.path / "r.txt");
+  const auto a = v.blob().bytes(), b = t.blob().bytes();
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size()), 0);
+  // Same tree, same words: lookups agree.
+  detail::SplitMix64 rng{4};
+  for (int i = 0; i < 100; ++i) {
+    const OrbDescriptor d = test::randomDescriptor(rng);
+    EXPECT_EQ(v.wordOf(d), t.wordOf(d));
+    EXPECT_LT(v.wordOf(d), 64u);
+  }
+}
+
+}  // namespace
+}  // namespace orbis::bow

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -309,6 +310,50 @@ Vocabulary<Descriptor, Distance> trainVocabulary(const std::vector<std::vector<D
     }
   }
   return Vocabulary<Descriptor, Distance>(VocabularyBlob::build(info, descBytes, nodes, words, "training"));
+}
+
+// A complete k-ary tree of depth L (k^L words) with uniformly random node descriptors and word
+// weights in (0, 1], from `seed`. Useless for place recognition; it is the stand-in for a large
+// trained vocabulary when only size matters (load-time benchmarks, file-format tests).
+template <class Descriptor, class Distance>
+Vocabulary<Descriptor, Distance> randomVocabulary(std::uint32_t k, std::uint32_t L, std::uint64_t seed) {
+  if (k < 2 || L < 1) throw Error("random vocabulary", "", "needs k >= 2 and L >= 1");
+  std::uint64_t total = 1, levelSize = 1;
+  for (std::uint32_t l = 0; l < L; ++l) {
+    levelSize *= k;
+    total += levelSize;
+    if (total >= 0xFFFFFFFFull) throw Error("random vocabulary", "", "more than 2^32 nodes");
+  }
+  detail::SplitMix64 rng{seed};
+  std::vector<Descriptor> descriptors(total);
+  std::vector<NodeRecord> nodes(total);
+  std::vector<WordRecord> words;
+  words.reserve(levelSize);
+  const std::uint64_t inner = total - levelSize;  // breadth-first: the leaves come last
+  for (std::uint64_t n = 0; n < total; ++n) {
+    std::uint8_t* bytes = descriptors[n].bytes();
+    // The root's descriptor stays zero: never compared, and DBoW2's text format omits it.
+    for (int b = 0; n > 0 && b < Descriptor::kBytes; b += 8) {
+      const std::uint64_t r = rng.next();
+      std::memcpy(bytes + b, &r, static_cast<std::size_t>(std::min(8, Descriptor::kBytes - b)));
+    }
+    NodeRecord& r = nodes[n];
+    r.parent = n == 0 ? kNoParent : static_cast<std::uint32_t>((n - 1) / k);
+    if (n < inner) {
+      r = {static_cast<std::uint32_t>(n * k + 1), k, kNoWord, r.parent};
+    } else {
+      r = {0, 0, static_cast<WordId>(words.size()), r.parent};
+      words.push_back({static_cast<NodeId>(n), static_cast<float>((rng.next() >> 40) + 1) / 16777216.0f});
+    }
+  }
+  VocabularyInfo info;
+  info.branching = k;
+  info.depth = L;
+  info.descriptorBytes = Descriptor::kBytes;
+  info.nodeCount = total;
+  info.wordCount = words.size();
+  return Vocabulary<Descriptor, Distance>(
+      VocabularyBlob::build(info, reinterpret_cast<const std::byte*>(descriptors.data()), nodes, words, "random vocabulary"));
 }
 
 }  // namespace orbis::bow
