@@ -2,6 +2,7 @@
 #include "command.hpp"
 #include "orbis/io/bal.hpp"
 #include "orbis/optim/bal.hpp"
+#include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
 
 #include <chrono>
@@ -64,6 +65,6 @@ int runBa(const std::vector<std::string>& args) {
 
 }  // namespace
 
-ORBIS_REGISTER_COMMAND({"ba", "solve a BAL bundle-adjustment problem (problem-*.txt)", runBa});
+ORBIS_REGISTER_COMMAND("ba", "solve a BAL bundle-adjustment problem (problem-*.txt)", runBa);
 
 }  // namespace orbis::cli
