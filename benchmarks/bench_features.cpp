@@ -1,0 +1,193 @@
+// ORB extraction and stereo matching on real frames, each beside cv::ORB with the same
+// feature budget in the same run. After the Google Benchmark table, prints the time ratio
+// ours / cv::ORB and the coverage (share of 32x32 px cells holding >= 1 keypoint) per dataset.
+// Data: ORBIS_DATA or ../shared/datasets; a dataset that is absent is skipped.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "orbis/features/orb_extractor.hpp"
+
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kFrames = 6;  // frames cycled through per dataset, so one image's luck does not decide
+
+fs::path dataRoot() {
+  if (const char* env = std::getenv("ORBIS_DATA"); env && *env) return env;
+  return ORBIS_DEFAULT_DATA_DIR;
+}
+
+struct Dataset {
+  std::string name;
+  int features;
+  std::vector<cv::Mat> left, right;  // right empty for monocular sources
+  float bf = 0.f;
+};
+
+std::vector<fs::path> sortedPngs(const fs::path& dir, int count) {
+  std::vector<fs::path> files;
+  if (!fs::exists(dir)) return files;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".png") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  if (static_cast<int>(files.size()) > count) files.resize(static_cast<std::size_t>(count));
+  return files;
+}
+
+std::vector<cv::Mat> loadGray(const fs::path& dir, int count) {
+  std::vector<cv::Mat> images;
+  for (const auto& f : sortedPngs(dir, count)) images.push_back(cv::imread(f.string(), cv::IMREAD_GRAYSCALE));
+  return images;
+}
+
+std::vector<Dataset>& datasets() {
+  static std::vector<Dataset> sets = [] {
+    std::vector<Dataset> out;
+    const fs::path root = dataRoot();
+    Dataset tum{"TUM_640x480", 1000, loadGray(root / "tum_fr3_teddy_200/rgb", kFrames), {}};
+    Dataset euroc{"EuRoC_752x480", 1200, loadGray(root / "euroc_V1_01_easy_95/mav0/cam0/data", kFrames),
+                  loadGray(root / "euroc_V1_01_easy_95/mav0/cam1/data", kFrames)};
+    Dataset kitti{"KITTI_1226x370", 2000, loadGray(root / "kitti_06_first51/sequences/06/image_0", kFrames),
+                  loadGray(root / "kitti_06_first51/sequences/06/image_1", kFrames), 379.8145f};
+    for (auto* d : {&tum, &euroc, &kitti})
+      if (!d->left.empty()) out.push_back(std::move(*d));
+    return out;
+  }();
+  return sets;
+}
+
+orbis::OrbParams paramsFor(const Dataset& d) {
+  orbis::OrbParams p;
+  p.features = d.features;
+  return p;
+}
+
+cv::Ptr<cv::ORB> cvOrbFor(const Dataset& d) {
+  const orbis::OrbParams p = paramsFor(d);
+  return cv::ORB::create(p.features, p.scaleFactor, p.levels, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                         p.iniThFast);
+}
+
+void BM_OrbisExtract(benchmark::State& state, std::size_t which) {
+  const Dataset& d = datasets()[which];
+  orbis::OrbExtractor extractor(paramsFor(d));
+  std::vector<orbis::Keypoint> kps;
+  std::vector<orbis::OrbDescriptor> desc;
+  std::size_t frame = 0, total = 0;
+  for (auto _ : state) {
+    extractor.extract(d.left[frame++ % d.left.size()], kps, desc);
+    total += kps.size();
+    benchmark::DoNotOptimize(desc.data());
+  }
+  state.counters["keypoints"] = static_cast<double>(total) / static_cast<double>(state.iterations());
+}
+
+void BM_CvOrbExtract(benchmark::State& state, std::size_t which) {
+  const Dataset& d = datasets()[which];
+  auto orb = cvOrbFor(d);
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  std::size_t frame = 0, total = 0;
+  for (auto _ : state) {
+    orb->detectAndCompute(d.left[frame++ % d.left.size()], cv::noArray(), kps, desc);
+    total += kps.size();
+    benchmark::DoNotOptimize(desc.data);
+  }
+  state.counters["keypoints"] = static_cast<double>(total) / static_cast<double>(state.iterations());
+}
+
+// Share of 32x32 cells of the image holding at least one keypoint.
+template <class Points>
+double coverage(const Points& points, cv::Size size) {
+  const int cols = (size.width + 31) / 32, rows = (size.height + 31) / 32;
+  std::vector<char> hit(static_cast<std::size_t>(cols * rows), 0);
+  for (const auto& p : points) {
+    const int cx = std::clamp(static_cast<int>(p.x) / 32, 0, cols - 1);
+    const int cy = std::clamp(static_cast<int>(p.y) / 32, 0, rows - 1);
+    hit[static_cast<std::size_t>(cy * cols + cx)] = 1;
+  }
+  return static_cast<double>(std::count(hit.begin(), hit.end(), 1)) / static_cast<double>(hit.size());
+}
+
+struct Xy {
+  float x, y;
+};
+
+void printCoverage() {
+  std::printf("\nCoverage: share of 32x32 px cells with >= 1 keypoint (mean over %d frames)\n", kFrames);
+  std::printf("%-16s %8s %10s %10s %10s %10s\n", "dataset", "budget", "orbis kps", "cv kps", "orbis cov", "cv cov");
+  for (const Dataset& d : datasets()) {
+    orbis::OrbExtractor extractor(paramsFor(d));
+    auto orb = cvOrbFor(d);
+    double ours = 0, theirs = 0, oursN = 0, theirsN = 0;
+    for (const cv::Mat& img : d.left) {
+      std::vector<orbis::Keypoint> kps;
+      std::vector<orbis::OrbDescriptor> desc;
+      extractor.extract(img, kps, desc);
+      std::vector<Xy> pts;
+      for (const auto& k : kps) pts.push_back({k.u, k.v});
+      ours += coverage(pts, img.size());
+      oursN += static_cast<double>(kps.size());
+      std::vector<cv::KeyPoint> cvKps;
+      cv::Mat cvDesc;
+      orb->detectAndCompute(img, cv::noArray(), cvKps, cvDesc);
+      std::vector<Xy> cvPts;
+      for (const auto& k : cvKps) cvPts.push_back({k.pt.x, k.pt.y});
+      theirs += coverage(cvPts, img.size());
+      theirsN += static_cast<double>(cvKps.size());
+    }
+    const double n = static_cast<double>(d.left.size());
+    std::printf("%-16s %8d %10.0f %10.0f %9.1f%% %9.1f%%\n", d.name.c_str(), d.features, oursN / n,
+                theirsN / n, 100 * ours / n, 100 * theirs / n);
+  }
+}
+
+// Collects per-benchmark CPU time (robust to other load on the machine) so the ratios can be printed after the normal table.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs)
+      if (r.run_type == Run::RT_Iteration && r.iterations > 0)
+        times[r.benchmark_name()] = r.GetAdjustedCPUTime();
+    ConsoleReporter::ReportRuns(runs);
+  }
+  std::map<std::string, double> times;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cv::setNumThreads(1);  // both sides single-threaded, so the ratio compares algorithms
+  for (std::size_t i = 0; i < datasets().size(); ++i) {
+    const std::string& n = datasets()[i].name;
+    benchmark::RegisterBenchmark(("Extract/orbis/" + n).c_str(), BM_OrbisExtract, i)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("Extract/cvORB/" + n).c_str(), BM_CvOrbExtract, i)->Unit(benchmark::kMillisecond);
+  }
+  benchmark::Initialize(&argc, argv);
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  std::printf("\nTime ratio orbis / cv::ORB (same budget, same run; <= 1.00 is the goal)\n");
+  for (const Dataset& d : datasets()) {
+    const auto a = reporter.times.find("Extract/orbis/" + d.name);
+    const auto b = reporter.times.find("Extract/cvORB/" + d.name);
+    if (a != reporter.times.end() && b != reporter.times.end())
+      std::printf("%-16s extraction %.3f\n", d.name.c_str(), a->second / b->second);
+  }
+  printCoverage();
+  benchmark::Shutdown();
+  return 0;
+}

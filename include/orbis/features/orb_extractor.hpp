@@ -1,0 +1,72 @@
+// orbis/features/orb_extractor.hpp — ORB-SLAM's ORB extractor: well-spread FAST corners with
+// intensity-centroid orientation and rotated BRIEF descriptors.
+//
+// Contract: satisfies FeatureExtractor. Per frame: a scale pyramid (OrbParams levels x
+// scaleFactor); a budget per level that falls geometrically with the level; FAST corners at
+// iniThFast over each level, then FAST at minThFast again in every ~30 px cell left empty; a
+// quadtree over each level's corners that keeps the strongest corner per node, so the
+// keypoints cover the whole image; orientation by intensity centroid over a circle of radius
+// 15; 256-bit rotated BRIEF with the standard learned pattern on the level blurred by a 7x7
+// Gaussian (sigma 2). Keypoints are ordered by level. The total may exceed the budget by a
+// few (the quadtree splits four ways) and falls short on images with too few corners.
+// Deterministic; not thread-safe (one extractor per image stream: buffers are reused).
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "orbis/features/descriptor.hpp"
+#include "orbis/features/extractor.hpp"
+#include "orbis/features/image_pyramid.hpp"
+#include "orbis/features/keypoint.hpp"
+#include "orbis/features/orb_params.hpp"
+
+namespace orbis {
+
+class OrbExtractor : public PyramidExtractorBase {
+ public:
+  static constexpr int kPatchSize = 31;
+  static constexpr int kHalfPatch = 15;
+  static constexpr int kEdge = 19;        // keypoints keep this far from each level's edge (ORB-SLAM)
+  static constexpr int kCellSize = 30;    // FAST fallback cells, level pixels
+  // Gaussian applied before the binary tests (ORB-SLAM: 7x7, sigma 2).
+  static constexpr int kBlurSize = 7;
+  static constexpr double kBlurSigma = 2.0;
+
+  explicit OrbExtractor(const OrbParams& params = {});
+
+  void extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
+               std::vector<OrbDescriptor>& descriptors);
+
+  // Keypoints wanted on each level (sums to params().features).
+  std::span<const int> featuresPerLevel() const { return featuresPerLevel_; }
+
+ private:
+  struct Corner {
+    float x, y, response;
+  };
+  struct Node {
+    float x0, y0, x1, y1;
+    int begin, end;  // range in corners_
+  };
+
+  void detectCorners(const cv::Mat& level);
+  void distribute(int wanted, float minX, float minY, float maxX, float maxY);
+  void splitNode(const Node& n, Node children[4], int& count);
+
+  std::vector<int> featuresPerLevel_;
+  std::vector<int> circleHalfWidth_;  // u_max of the orientation circle, per row offset
+  cv::Mat gray_;
+  std::vector<cv::Mat> blurred_;  // per level: sizes differ, so one buffer would reallocate
+  std::vector<cv::KeyPoint> fast_;
+  std::vector<Corner> corners_;
+  std::vector<Node> nodes_, nextNodes_;
+  std::vector<int> cellCount_, selected_, splittable_;
+  std::vector<Keypoint> levelKeypoints_;
+};
+
+static_assert(FeatureExtractor<OrbExtractor>);
+
+}  // namespace orbis

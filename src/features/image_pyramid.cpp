@@ -1,0 +1,53 @@
+// Scale pyramid with reflected borders; see include/orbis/features/image_pyramid.hpp.
+#include "orbis/features/image_pyramid.hpp"
+
+#include <cmath>
+#include <cstring>
+
+#include <opencv2/imgproc.hpp>
+
+namespace orbis {
+
+void ImagePyramid::fillBorder(cv::Mat& bordered, int border) {
+  const int w = bordered.cols - 2 * border;
+  const int h = bordered.rows - 2 * border;
+  if (w <= border || h <= border) {
+    // Too small to reflect in place; a copy through copyMakeBorder is rare and cheap here.
+    cv::Mat inner = bordered(cv::Rect(border, border, w, h)).clone();
+    cv::copyMakeBorder(inner, bordered, border, border, border, border, cv::BORDER_REPLICATE);
+    return;
+  }
+  for (int r = border; r < border + h; ++r) {
+    std::uint8_t* p = bordered.ptr<std::uint8_t>(r);
+    for (int k = 1; k <= border; ++k) {
+      p[border - k] = p[border + k];
+      p[border + w - 1 + k] = p[border + w - 1 - k];
+    }
+  }
+  const auto rowBytes = static_cast<std::size_t>(bordered.cols);
+  for (int k = 1; k <= border; ++k) {
+    std::memcpy(bordered.ptr(border - k), bordered.ptr(border + k), rowBytes);
+    std::memcpy(bordered.ptr(border + h - 1 + k), bordered.ptr(border + h - 1 - k), rowBytes);
+  }
+}
+
+void ImagePyramid::build(const cv::Mat& gray8u, const ScaleLevels& levels) {
+  CV_Assert(gray8u.type() == CV_8UC1);
+  const auto n = static_cast<std::size_t>(levels.levels());
+  bordered_.resize(n);
+  interior_.resize(n);
+  for (std::size_t l = 0; l < n; ++l) {
+    const cv::Size size(static_cast<int>(std::lround(gray8u.cols * levels.invScale[l])),
+                        static_cast<int>(std::lround(gray8u.rows * levels.invScale[l])));
+    bordered_[l].create(size.height + 2 * kBorder, size.width + 2 * kBorder, CV_8UC1);
+    interior_[l] = bordered_[l](cv::Rect(kBorder, kBorder, size.width, size.height));
+    if (l == 0) {
+      gray8u.copyTo(interior_[l]);
+    } else {
+      cv::resize(interior_[l - 1], interior_[l], size, 0, 0, cv::INTER_LINEAR);
+    }
+    fillBorder(bordered_[l], kBorder);
+  }
+}
+
+}  // namespace orbis

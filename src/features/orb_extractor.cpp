@@ -1,0 +1,309 @@
+// ORB-SLAM's extractor; see include/orbis/features/orb_extractor.hpp for the contract.
+#include "orbis/features/orb_extractor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "orb_pattern.hpp"
+
+namespace orbis {
+namespace {
+
+// Intensity centroid of the circular patch (radius kHalfPatch) around `center`; the angle of
+// the vector from the centre to the centroid, in degrees. Integer moments: exact and fast.
+float centroidAngle(const std::uint8_t* center, int step, const std::vector<int>& halfWidth) {
+  constexpr int r = OrbExtractor::kHalfPatch;
+  int m01 = 0, m10 = 0;
+  for (int u = -r; u <= r; ++u) m10 += u * center[u];
+  for (int v = 1; v <= r; ++v) {
+    // Rows +v and -v together: their difference feeds m01, their sum m10.
+    int rowDifference = 0;
+    const int d = halfWidth[static_cast<std::size_t>(v)];
+    const std::uint8_t* below = center + v * step;
+    const std::uint8_t* above = center - v * step;
+    for (int u = -d; u <= d; ++u) {
+      const int plus = below[u], minus = above[u];
+      rowDifference += plus - minus;
+      m10 += u * (plus + minus);
+    }
+    m01 += v * rowDifference;
+  }
+  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+}
+
+// The pattern as floats, one array per coordinate, points 2i and 2i+1 forming test i.
+struct PatternSoA {
+  alignas(16) float x[2 * OrbDescriptor::kBits];
+  alignas(16) float y[2 * OrbDescriptor::kBits];
+  PatternSoA() {
+    for (int k = 0; k < 2 * OrbDescriptor::kBits; ++k) {
+      x[k] = static_cast<float>(detail::kOrbPattern[2 * k]);
+      y[k] = static_cast<float>(detail::kOrbPattern[2 * k + 1]);
+    }
+  }
+};
+const PatternSoA& pattern() {
+  static const PatternSoA p;
+  return p;
+}
+
+// Rotated BRIEF: each pattern point is rotated by the keypoint angle and rounded to the
+// nearest pixel (round-half-even, like cvRound), then 256 intensity comparisons.
+void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDescriptor& out) {
+  constexpr int kPoints = 2 * OrbDescriptor::kBits;
+  const float rad = angleDeg * static_cast<float>(CV_PI / 180.0);
+  const float a = std::cos(rad), b = std::sin(rad);
+  const PatternSoA& p = pattern();
+  alignas(16) int offset[kPoints];
+#if defined(__SSE2__)
+  const __m128 va = _mm_set1_ps(a), vb = _mm_set1_ps(b);
+  const __m128 vstep = _mm_set1_ps(static_cast<float>(step));
+  for (int k = 0; k < kPoints; k += 4) {
+    const __m128 x = _mm_load_ps(p.x + k), y = _mm_load_ps(p.y + k);
+    const __m128i ix = _mm_cvtps_epi32(_mm_sub_ps(_mm_mul_ps(x, va), _mm_mul_ps(y, vb)));
+    const __m128i iy = _mm_cvtps_epi32(_mm_add_ps(_mm_mul_ps(x, vb), _mm_mul_ps(y, va)));
+    // iy*step + ix is exact in float (|value| < 2^24), so no 32-bit integer multiply needed.
+    const __m128 o = _mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(iy), vstep), _mm_cvtepi32_ps(ix));
+    _mm_store_si128(reinterpret_cast<__m128i*>(offset + k), _mm_cvtps_epi32(o));
+  }
+#else
+  for (int k = 0; k < kPoints; ++k)
+    offset[k] = cvRound(p.x[k] * b + p.y[k] * a) * step + cvRound(p.x[k] * a - p.y[k] * b);
+#endif
+  std::uint8_t* bytes = out.bytes();
+  const int* o = offset;
+  for (int i = 0; i < OrbDescriptor::kBytes; ++i) {
+    int byte = 0;
+    for (int bit = 0; bit < 8; ++bit, o += 2) byte |= (center[o[0]] < center[o[1]]) << bit;
+    bytes[i] = static_cast<std::uint8_t>(byte);
+  }
+}
+
+}  // namespace
+
+OrbExtractor::OrbExtractor(const OrbParams& params)
+    : PyramidExtractorBase(params) {
+  // Budget per level proportional to the level's area ratio along a geometric series, the
+  // last level taking the remainder (as ORB-SLAM).
+  const int n = scales_.levels();
+  featuresPerLevel_.assign(static_cast<std::size_t>(n), 0);
+  const float factor = 1.f / params.scaleFactor;
+  float perLevel = static_cast<float>(params.features) * (1.f - factor) /
+                   (1.f - std::pow(factor, static_cast<float>(n)));
+  if (n == 1) perLevel = static_cast<float>(params.features);
+  int assigned = 0;
+  for (int l = 0; l < n - 1; ++l) {
+    featuresPerLevel_[static_cast<std::size_t>(l)] = static_cast<int>(std::lround(perLevel));
+    assigned += featuresPerLevel_[static_cast<std::size_t>(l)];
+    perLevel *= factor;
+  }
+  featuresPerLevel_[static_cast<std::size_t>(n - 1)] = std::max(params.features - assigned, 0);
+  blurred_.resize(static_cast<std::size_t>(n));
+
+  // Half-width of each row of the orientation circle, made symmetric under swapping u and v so
+  // the moments do not favour an axis.
+  const int r = kHalfPatch;
+  circleHalfWidth_.assign(static_cast<std::size_t>(r + 1), 0);
+  const int vmax = cvFloor(r * std::sqrt(2.f) / 2 + 1);
+  const int vmin = cvCeil(r * std::sqrt(2.f) / 2);
+  for (int v = 0; v <= vmax; ++v)
+    circleHalfWidth_[static_cast<std::size_t>(v)] = cvRound(std::sqrt(double(r * r - v * v)));
+  for (int v = r, v0 = 0; v >= vmin; --v) {
+    while (circleHalfWidth_[static_cast<std::size_t>(v0)] == circleHalfWidth_[static_cast<std::size_t>(v0 + 1)]) ++v0;
+    circleHalfWidth_[static_cast<std::size_t>(v)] = v0;
+    ++v0;
+  }
+}
+
+void OrbExtractor::detectCorners(const cv::Mat& level) {
+  corners_.clear();
+  const int minX = kEdge, minY = kEdge, maxX = level.cols - kEdge, maxY = level.rows - kEdge;
+  if (maxX - minX < kCellSize / 2 || maxY - minY < kCellSize / 2) return;
+
+  // FAST needs 3 pixels of context beyond the area where it reports corners.
+  auto fastIn = [&](int x0, int y0, int x1, int y1, int threshold) {
+    cv::FAST(level(cv::Rect(x0 - 3, y0 - 3, x1 - x0 + 6, y1 - y0 + 6)), fast_, threshold, true);
+    for (const cv::KeyPoint& k : fast_)
+      corners_.push_back({k.pt.x + static_cast<float>(x0 - 3), k.pt.y + static_cast<float>(y0 - 3), k.response});
+  };
+
+  // One pass over the whole level at the high threshold finds the same corners as per-cell
+  // passes would, without their overlap and per-call overhead.
+  fastIn(minX, minY, maxX, maxY, params_.iniThFast);
+
+  const int cols = std::max(1, (maxX - minX) / kCellSize);
+  const int rows = std::max(1, (maxY - minY) / kCellSize);
+  const int cellW = (maxX - minX + cols - 1) / cols;
+  const int cellH = (maxY - minY + rows - 1) / rows;
+  cellCount_.assign(static_cast<std::size_t>(cols * rows), 0);
+  for (const Corner& c : corners_) {
+    const int cx = std::min(cols - 1, (static_cast<int>(c.x) - minX) / cellW);
+    const int cy = std::min(rows - 1, (static_cast<int>(c.y) - minY) / cellH);
+    ++cellCount_[static_cast<std::size_t>(cy * cols + cx)];
+  }
+  // Cells the high threshold left empty (low contrast) get a second chance at the low one.
+  // Empty cells are searched in rectangles (a run along the row, extended down while the
+  // cells below are empty too): the same corners inside each cell, without re-reading the
+  // 3-pixel context of every cell or paying the per-call overhead per cell.
+  for (int cy = 0; cy < rows; ++cy) {
+    for (int cx = 0; cx < cols;) {
+      int* counts = cellCount_.data() + static_cast<std::ptrdiff_t>(cy * cols);
+      if (counts[cx] != 0) {
+        ++cx;
+        continue;
+      }
+      int runEnd = cx + 1;
+      while (runEnd < cols && counts[runEnd] == 0) ++runEnd;
+      int rowEnd = cy + 1;
+      for (; rowEnd < rows; ++rowEnd) {
+        int* below = cellCount_.data() + static_cast<std::ptrdiff_t>(rowEnd * cols);
+        if (std::any_of(below + cx, below + runEnd, [](int n) { return n != 0; })) break;
+        std::fill(below + cx, below + runEnd, -1);  // searched with this rectangle
+      }
+      const int x0 = minX + cx * cellW, x1 = std::min(maxX, minX + runEnd * cellW);
+      const int y0 = minY + cy * cellH, y1 = std::min(maxY, minY + rowEnd * cellH);
+      if (x1 > x0 && y1 > y0) fastIn(x0, y0, x1, y1, params_.minThFast);
+      cx = runEnd;
+    }
+  }
+}
+
+void OrbExtractor::splitNode(const Node& n, Node children[4], int& count) {
+  const float halfX = std::ceil((n.x1 - n.x0) / 2.f), halfY = std::ceil((n.y1 - n.y0) / 2.f);
+  const float midX = n.x0 + halfX, midY = n.y0 + halfY;
+  auto* first = corners_.data() + n.begin;
+  auto* last = corners_.data() + n.end;
+  auto* midRow = std::partition(first, last, [midY](const Corner& c) { return c.y < midY; });
+  auto* midTop = std::partition(first, midRow, [midX](const Corner& c) { return c.x < midX; });
+  auto* midBottom = std::partition(midRow, last, [midX](const Corner& c) { return c.x < midX; });
+  const auto at = [&](const Corner* p) { return static_cast<int>(p - corners_.data()); };
+  const Node quarters[4] = {{n.x0, n.y0, midX, midY, n.begin, at(midTop)},
+                            {midX, n.y0, n.x1, midY, at(midTop), at(midRow)},
+                            {n.x0, midY, midX, n.y1, at(midRow), at(midBottom)},
+                            {midX, midY, n.x1, n.y1, at(midBottom), n.end}};
+  count = 0;
+  for (const Node& q : quarters)
+    if (q.end > q.begin) children[count++] = q;
+}
+
+void OrbExtractor::distribute(int wanted, float minX, float minY, float maxX, float maxY) {
+  selected_.clear();
+  if (corners_.empty() || wanted <= 0) return;
+  const auto target = static_cast<std::size_t>(wanted);
+
+  // Root nodes: square-ish vertical strips so the quadtree cells stay roughly square.
+  const int strips = std::max(1, static_cast<int>(std::lround((maxX - minX) / (maxY - minY))));
+  const float stripW = (maxX - minX) / static_cast<float>(strips);
+  nodes_.clear();
+  auto* begin = corners_.data();
+  for (int i = 0; i < strips; ++i) {
+    const float x1 = i + 1 == strips ? maxX + 1.f : minX + stripW * static_cast<float>(i + 1);
+    auto* end = std::partition(begin, corners_.data() + corners_.size(),
+                               [x1](const Corner& c) { return c.x < x1; });
+    if (end > begin)
+      nodes_.push_back({minX + stripW * static_cast<float>(i), minY, x1, maxY,
+                        static_cast<int>(begin - corners_.data()), static_cast<int>(end - corners_.data())});
+    begin = end;
+  }
+
+  Node children[4];
+  int count = 0;
+  for (;;) {
+    nextNodes_.clear();
+    std::size_t expandable = 0;
+    for (const Node& n : nodes_) {
+      if (n.end - n.begin == 1) {
+        nextNodes_.push_back(n);
+        continue;
+      }
+      splitNode(n, children, count);
+      for (int k = 0; k < count; ++k) {
+        nextNodes_.push_back(children[k]);
+        if (children[k].end - children[k].begin > 1) ++expandable;
+      }
+    }
+    const bool unchanged = nextNodes_.size() == nodes_.size();
+    nodes_.swap(nextNodes_);
+    if (nodes_.size() >= target || unchanged) break;
+    if (nodes_.size() + 3 * expandable > target) {
+      // A full round would overshoot: split the most populated nodes first, one at a time.
+      while (nodes_.size() < target) {
+        splittable_.clear();
+        for (std::size_t i = 0; i < nodes_.size(); ++i)
+          if (nodes_[i].end - nodes_[i].begin > 1) splittable_.push_back(static_cast<int>(i));
+        if (splittable_.empty()) break;
+        std::stable_sort(splittable_.begin(), splittable_.end(), [this](int a, int b) {
+          const auto& na = nodes_[static_cast<std::size_t>(a)];
+          const auto& nb = nodes_[static_cast<std::size_t>(b)];
+          return na.end - na.begin > nb.end - nb.begin;
+        });
+        const std::size_t before = nodes_.size();
+        for (int idx : splittable_) {
+          splitNode(nodes_[static_cast<std::size_t>(idx)], children, count);
+          nodes_[static_cast<std::size_t>(idx)] = children[0];
+          for (int k = 1; k < count; ++k) nodes_.push_back(children[k]);
+          if (nodes_.size() >= target) break;
+        }
+        if (nodes_.size() == before) break;  // coincident corners cannot be separated
+      }
+      break;
+    }
+  }
+
+  for (const Node& n : nodes_) {
+    int best = n.begin;
+    for (int i = n.begin + 1; i < n.end; ++i)
+      if (corners_[static_cast<std::size_t>(i)].response > corners_[static_cast<std::size_t>(best)].response) best = i;
+    selected_.push_back(best);
+  }
+}
+
+void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
+                           std::vector<OrbDescriptor>& descriptors) {
+  const cv::Mat& gray = detail::asGray8u(image, gray_, "OrbExtractor input");
+  keypoints.clear();
+  descriptors.clear();
+  if (gray.empty()) return;
+  pyramid_.build(gray, scales_);
+  keypoints.reserve(static_cast<std::size_t>(params_.features) + 64);
+  descriptors.reserve(keypoints.capacity());
+
+  constexpr int b = ImagePyramid::kBorder;
+  for (int l = 0; l < levels(); ++l) {
+    const cv::Mat& level = pyramid_.level(l);
+    detectCorners(level);
+    distribute(featuresPerLevel_[static_cast<std::size_t>(l)], static_cast<float>(kEdge),
+               static_cast<float>(kEdge), static_cast<float>(level.cols - kEdge),
+               static_cast<float>(level.rows - kEdge));
+    if (selected_.empty()) continue;
+
+    // Pattern points lie within 18.4 px of the keypoint, which is kEdge (19) px inside, so
+    // the tests read only the interior; the blur there reads the reflected border as context.
+    cv::Mat& blurred = blurred_[static_cast<std::size_t>(l)];
+    blurred.create(level.rows + 2 * b, level.cols + 2 * b, CV_8UC1);
+    cv::Mat target = blurred(cv::Rect(b, b, level.cols, level.rows));
+    cv::GaussianBlur(level, target, cv::Size(kBlurSize, kBlurSize), kBlurSigma, kBlurSigma,
+                     cv::BORDER_REFLECT_101);
+
+    const int step = static_cast<int>(level.step);
+    const int blurStep = static_cast<int>(blurred.step);
+    const float scale = scales_.scale[static_cast<std::size_t>(l)];
+    for (int idx : selected_) {
+      const Corner& c = corners_[static_cast<std::size_t>(idx)];
+      const int x = cvRound(c.x), y = cvRound(c.y);
+      const float angle = centroidAngle(level.ptr<std::uint8_t>(y) + x, step, circleHalfWidth_);
+      OrbDescriptor& d = descriptors.emplace_back();
+      briefDescriptor(blurred.ptr<std::uint8_t>(y + b) + x + b, blurStep, angle, d);
+      keypoints.push_back({c.x * scale, c.y * scale, angle, c.response, l});
+    }
+  }
+}
+
+}  // namespace orbis
