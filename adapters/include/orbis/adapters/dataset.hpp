@@ -1,0 +1,105 @@
+// orbis/adapters/dataset.hpp — benchmark sequences (TUM RGB-D, EuRoC MAV, KITTI odometry)
+// read frame by frame, in their own on-disk layouts.
+//
+// Contract: openDataset reads only the small text files (lists, timestamps, calibration,
+// ground truth) and checks them; images are loaded when a frame is asked for, so a whole
+// sequence is never held in memory. Frames come in time order; frame(i) may be called in any
+// order. A missing file, an unreadable image, a malformed line or timestamps out of order
+// throw orbis::Error naming the file (and the line, for text files). A missing right image or
+// depth map is reported on the frame (DatasetFrame::warnings) or, with DatasetOptions::strict,
+// thrown; it is never skipped silently. Ground truth is given as camera-to-world poses of the
+// left (or colour) camera — for EuRoC, of the rectified left camera when rectifying.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "orbis/camera/distortion.hpp"
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/camera/sensor_kind.hpp"
+#include "orbis/camera/stereo.hpp"
+#include "orbis/io/trajectory.hpp"
+
+namespace orbis {
+
+enum class DatasetKind { TumRgbd, Euroc, Kitti };
+// SensorKind: orbis/camera/sensor_kind.hpp (shared with the dataset readers).
+
+// "tum", "euroc", "kitti"; throws orbis::Error(source) otherwise.
+DatasetKind parseDatasetKind(std::string_view name, const std::string& source = "dataset kind");
+std::string_view toString(DatasetKind kind);
+SensorKind parseSensorKind(std::string_view name, const std::string& source = "sensor");
+std::string_view toString(SensorKind sensor);
+// Recognises a dataset folder by its files (rgb.txt; mav0/; sequences/ or times.txt).
+std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root);
+
+struct DatasetOptions {
+  // The sensor to read as; empty means the dataset's own (TUM: RGB-D, EuRoC and KITTI: stereo,
+  // or monocular when the KITTI sequence has no image_1). Monocular skips right/depth images.
+  std::optional<SensorKind> sensor;
+  double maxDepthDt = 0.02;          // TUM: largest |t_rgb - t_depth| of an associated pair, seconds
+  double maxStereoDt = 0.003;        // EuRoC: largest |t_cam0 - t_cam1| of a stereo pair, seconds
+  double tumDepthScale = 5000.0;     // TUM: raw depth value / scale = metres
+  double tumVirtualBaseline = 0.08;  // TUM: metres (the paper's 8 cm for Kinect-type sensors)
+  bool rectify = true;        // EuRoC: deliver rectified images and calibration (what the pipeline eats)
+  bool strict = false;        // a missing right image or depth map throws instead of warning
+  std::string kittiSequence;  // KITTI: "06" when root holds several sequences
+};
+
+struct DatasetFrame {
+  std::size_t index = 0;
+  double timestamp = 0.0;  // seconds
+  cv::Mat left;            // 8-bit, grey or BGR as stored (the colour image for RGB-D)
+  cv::Mat right;           // stereo only; empty when missing (see warnings)
+  cv::Mat depth;           // RGB-D only: CV_32F metres, 0 = no reading; empty when missing
+  std::vector<std::string> warnings;
+};
+
+// The camera a sequence is seen through, as the dataset calibrates it.
+using DatasetCamera = std::variant<PinholeCamera<double>, RectifiedStereoCamera<double>, RgbdCamera<double>>;
+
+class DatasetReader {
+ public:
+  virtual ~DatasetReader() = default;
+
+  virtual DatasetKind kind() const = 0;
+  virtual SensorKind sensor() const = 0;
+  virtual std::size_t size() const = 0;
+  virtual double timestamp(std::size_t index) const = 0;  // without loading images
+  // Loads frame index (< size()); throws orbis::Error for an unreadable image.
+  virtual DatasetFrame frame(std::size_t index) const = 0;
+  // Camera-to-world poses of the left/colour camera, time-ordered; empty when the dataset has none.
+  virtual const Trajectory& groundTruth() const = 0;
+  virtual DatasetCamera camera() const = 0;
+  // Lens distortion still present in the delivered left images (zero when they are rectified
+  // or undistorted already): TUM freiburg1/2 images are distorted.
+  virtual RadTanDistortion<double> distortion() const { return {}; }
+  virtual const std::filesystem::path& root() const = 0;
+
+  // Sequential reading: the next frame, or nothing past the end.
+  std::optional<DatasetFrame> next() {
+    if (cursor_ >= size()) return std::nullopt;
+    return frame(cursor_++);
+  }
+  void rewind() { cursor_ = 0; }
+
+ private:
+  std::size_t cursor_ = 0;
+};
+
+std::unique_ptr<DatasetReader> openDataset(DatasetKind kind, const std::filesystem::path& root,
+                                           const DatasetOptions& options = {});
+
+// The individual readers, for callers that know the kind at compile time.
+std::unique_ptr<DatasetReader> openTumRgbd(const std::filesystem::path& root, const DatasetOptions& options);
+std::unique_ptr<DatasetReader> openEuroc(const std::filesystem::path& root, const DatasetOptions& options);
+std::unique_ptr<DatasetReader> openKitti(const std::filesystem::path& root, const DatasetOptions& options);
+
+}  // namespace orbis

@@ -1,0 +1,195 @@
+// Small datasets written to a temporary folder, then broken one way at a time: every error
+// names the file (and line), and a missing right image or depth map is reported, not skipped.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+
+#include "orbis/adapters/dataset.hpp"
+#include "orbis/util/error.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+class CorruptInputs : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ =
+        fs::temp_directory_path() /
+        ("orbis_adapters_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  void writeText(const fs::path& relative, const std::string& text) {
+    fs::create_directories((root_ / relative).parent_path());
+    std::ofstream(root_ / relative) << text;
+  }
+  void writeImage(const fs::path& relative, int type) {
+    fs::create_directories((root_ / relative).parent_path());
+    cv::Mat image(48, 64, type, cv::Scalar::all(type == CV_16UC1 ? 5000 : 128));
+    ASSERT_TRUE(cv::imwrite((root_ / relative).string(), image));
+  }
+
+  // A three-frame TUM sequence; depth listed for all three.
+  void makeTum() {
+    std::string rgb = "# color images\n# file: 'rgbd_dataset_freiburg3_test.bag'\n", depth = "# depth\n";
+    for (int i = 0; i < 3; ++i) {
+      const std::string t = "100." + std::to_string(i) + "00000";
+      rgb += t + " rgb/" + t + ".png\n";
+      depth += t + "1 depth/" + t + "1.png\n";
+      writeImage("rgb/" + t + ".png", CV_8UC3);
+      writeImage("depth/" + t + "1.png", CV_16UC1);
+    }
+    writeText("rgb.txt", rgb);
+    writeText("depth.txt", depth);
+    writeText("groundtruth.txt", "# gt\n100.0 0 0 0 0 0 0 1\n100.1 0 0 1 0 0 0 1\n");
+  }
+
+  // A two-frame KITTI sequence with both cameras.
+  void makeKitti() {
+    const std::string p = " 700 0 600 0 0 700 180 0 0 0 1 0\n";
+    writeText("sequences/00/calib.txt", "P0:" + p + "P1: 700 0 600 -350 0 700 180 0 0 0 1 0\n");
+    writeText("sequences/00/times.txt", "0.0\n0.1\n");
+    for (int i = 0; i < 2; ++i)
+      for (int c = 0; c < 2; ++c)
+        writeImage("sequences/00/image_" + std::to_string(c) + "/00000" + std::to_string(i) + ".png",
+                   CV_8UC1);
+  }
+
+  // Expects an orbis::Error whose source is root_/file and whose location is `where`.
+  template <class F>
+  void expectError(F&& open, const fs::path& file, const std::string& where) {
+    try {
+      open();
+      ADD_FAILURE() << "no error; expected one naming " << file << " " << where;
+    } catch (const orbis::Error& e) {
+      EXPECT_EQ(fs::path(e.source()), root_ / file) << e.what();
+      EXPECT_EQ(e.where(), where) << e.what();
+    }
+  }
+
+  fs::path root_;
+};
+
+TEST_F(CorruptInputs, IntactTumSequenceReadsCleanly) {
+  makeTum();
+  const auto reader = orbis::openTumRgbd(root_, {});
+  ASSERT_EQ(reader->size(), 3u);
+  const auto f = reader->frame(2);
+  EXPECT_TRUE(f.warnings.empty());
+  EXPECT_FLOAT_EQ(f.depth.at<float>(0, 0), 1.0f);  // 5000 / 5000
+  EXPECT_EQ(reader->groundTruth().size(), 2u);
+}
+
+TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {
+  makeTum();
+  writeText("rgb.txt", "# c\n100.0 rgb/100.000000.png\n100.1 rgb/100.100000.png extra\n");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 3");
+  writeText("rgb.txt", "100.1 rgb/100.100000.png\n100.0 rgb/100.000000.png\n");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 2");
+  writeText("rgb.txt", "100.0 rgb/100.000000.png\nabc rgb/100.100000.png\n");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 2");
+  writeText("rgb.txt", "100.0 rgb/100.000000.png\n100.5 rgb/nothere.png\n");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 2");
+  fs::remove(root_ / "rgb.txt");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "");
+}
+
+TEST_F(CorruptInputs, TumGroundTruthErrorsNameTheLine) {
+  makeTum();
+  writeText("groundtruth.txt", "# gt\n100.0 0 0 0 0 0 0 1\n100.1 0 0 1 0 0 1\n");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "groundtruth.txt", "line 3");
+}
+
+TEST_F(CorruptInputs, TumUnreadableImageNamesFileAndLine) {
+  makeTum();
+  writeText("rgb/100.100000.png", "this is not a PNG");
+  const auto reader = orbis::openTumRgbd(root_, {});
+  expectError([&] { reader->frame(1); }, "rgb.txt", "line 4");
+  EXPECT_NO_THROW(reader->frame(0));
+}
+
+TEST_F(CorruptInputs, TumMissingDepthIsAWarningOrAStrictError) {
+  makeTum();
+  fs::remove(root_ / "depth/100.1000001.png");
+  const auto reader = orbis::openTumRgbd(root_, {});
+  const auto f = reader->frame(1);
+  EXPECT_TRUE(f.depth.empty());
+  ASSERT_EQ(f.warnings.size(), 1u);
+  EXPECT_NE(f.warnings[0].find("depth.txt, line 3"), std::string::npos) << f.warnings[0];
+  EXPECT_TRUE(reader->frame(0).warnings.empty());
+
+  orbis::DatasetOptions strict;
+  strict.strict = true;
+  expectError([&] { orbis::openTumRgbd(root_, strict); }, "depth.txt", "line 3");
+
+  // A depth map too far in time from its colour image is missing too.
+  writeText("depth.txt", "100.0000001 depth/100.0000001.png\n100.2000001 depth/100.2000001.png\n");
+  const auto sparse = orbis::openTumRgbd(root_, {});
+  EXPECT_EQ(sparse->frame(1).warnings.size(), 1u);
+  expectError([&] { orbis::openTumRgbd(root_, strict); }, "rgb.txt", "line 4");
+}
+
+TEST_F(CorruptInputs, KittiErrorsNameFileAndLineOrKey) {
+  makeKitti();
+  const auto intact = orbis::openKitti(root_, {});
+  EXPECT_EQ(intact->size(), 2u);
+  EXPECT_NEAR(std::get<orbis::RectifiedStereoCamera<double>>(intact->camera()).baseline, 0.5, 1e-12);
+
+  writeText("sequences/00/times.txt", "0.1\n0.0\n");
+  expectError([&] { orbis::openKitti(root_, {}); }, "sequences/00/times.txt", "line 2");
+  writeText("sequences/00/times.txt", "0.0\n0.1\n0.2\n");  // a third frame without images
+  expectError([&] { orbis::openKitti(root_, {}); }, "sequences/00/times.txt", "line 3");
+  writeText("sequences/00/times.txt", "0.0\n0.1\n");
+
+  writeText("sequences/00/calib.txt", "P0: 700 0 600 0 0 700 180 0 0 0 1 0\n");
+  expectError([&] { orbis::openKitti(root_, {}); }, "sequences/00/calib.txt", "key P1");
+  writeText("sequences/00/calib.txt", "P0: 700 0 600 0 0 700 180 0 0 0 1\nP1: 1 2\n");
+  expectError([&] { orbis::openKitti(root_, {}); }, "sequences/00/calib.txt", "line 1");
+  makeKitti();
+
+  writeText("poses/00.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 x\n");
+  expectError([&] { orbis::openKitti(root_, {}); }, "poses/00.txt", "line 2");
+  writeText("poses/00.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n");  // one pose for two frames
+  expectError([&] { orbis::openKitti(root_, {}); }, "sequences/00/times.txt", "");
+}
+
+TEST_F(CorruptInputs, KittiMissingRightImageIsReported) {
+  makeKitti();
+  fs::remove(root_ / "sequences/00/image_1/000001.png");
+  const auto reader = orbis::openKitti(root_ / "sequences" / "00", {});
+  const auto f = reader->frame(1);
+  EXPECT_TRUE(f.right.empty());
+  ASSERT_EQ(f.warnings.size(), 1u);
+  EXPECT_NE(f.warnings[0].find("000001.png"), std::string::npos);
+  orbis::DatasetOptions strict;
+  strict.strict = true;
+  expectError([&] { orbis::openKitti(root_, strict); }, "sequences/00/times.txt", "line 2");
+}
+
+TEST_F(CorruptInputs, EurocErrorsNameFileAndLine) {
+  writeText("mav0/cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png\n900000000,b.png\n");
+  writeImage("mav0/cam0/data/a.png", CV_8UC1);
+  writeImage("mav0/cam0/data/b.png", CV_8UC1);
+  expectError([&] { orbis::openEuroc(root_, {}); }, "mav0/cam0/data.csv", "line 3");
+  writeText("mav0/cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png\n1.5e9,b.png\n");
+  expectError([&] { orbis::openEuroc(root_, {}); }, "mav0/cam0/data.csv", "line 3");
+  writeText("mav0/cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png\n1050000000,b.png\n");
+  expectError([&] { orbis::openEuroc(root_, {}); }, "mav0/cam0/sensor.yaml", "");
+}
+
+TEST(DatasetNames, ParseAndDetect) {
+  EXPECT_EQ(orbis::parseDatasetKind("euroc"), orbis::DatasetKind::Euroc);
+  EXPECT_EQ(orbis::parseSensorKind("mono"), orbis::SensorKind::Monocular);
+  EXPECT_THROW(orbis::parseDatasetKind("bonn"), orbis::Error);
+  EXPECT_THROW(orbis::parseSensorKind("lidar"), orbis::Error);
+  EXPECT_FALSE(orbis::detectDatasetKind(fs::temp_directory_path() / "orbis_no_such_dataset").has_value());
+}
+
+}  // namespace
