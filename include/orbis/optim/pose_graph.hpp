@@ -1,0 +1,35 @@
+// orbis/optim/pose_graph.hpp — essential-graph optimisation (paper §III-D): poses only, linked
+// by relative-pose edges (spanning tree, strong covisibility, loop edges).
+//
+// Contract: poses are camera-from-world; an edge (i, j) carries T_ij = T_iw·T_jw⁻¹ as measured
+// before the loop correction, and an isotropic information weight. Fixed poses (at least one,
+// usually the loop keyframe) are never written. ORB-SLAM runs 20 LM iterations; that is the
+// default here. Stereo/RGB-D maps use SE(3); monocular maps Sim(3) (sim3_pose_graph.hpp).
+#pragma once
+
+#include "orbis/geometry/se3.hpp"
+#include "orbis/optim/solver_options.hpp"
+
+#include <span>
+#include <vector>
+
+namespace orbis::optim {
+
+struct PoseGraphEdgeSE3 {
+  int i = 0;
+  int j = 0;
+  SE3d relative;  // T_ij
+  double information = 1.0;
+};
+
+inline SolverOptions essentialGraphOptions() {
+  SolverOptions options;
+  options.maxIterations = 20;
+  return options;
+}
+
+SolverSummary optimizePoseGraph(std::vector<SE3d>& cameraFromWorld, const std::vector<char>& fixed,
+                                std::span<const PoseGraphEdgeSE3> edges,
+                                const SolverOptions& options = essentialGraphOptions());
+
+}  // namespace orbis::optim

