@@ -50,6 +50,15 @@ class TextFile {
   std::ofstream out_;
 };
 
+// A YAML real that reads back as a real (cv::FileStorage takes "500" for an integer).
+std::string yamlReal(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  std::string s = buf;
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
 void makeDirectories(const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -91,7 +100,8 @@ void writeEurocSensorYaml(const fs::path& file, const SyntheticSequence& seq, in
   f.printf("  data: [1.0, 0.0, 0.0, %.9f,\n         0.0, 1.0, 0.0, 0.0,\n         0.0, 0.0, 1.0, 0.0,\n"
            "         0.0, 0.0, 0.0, 1.0]\n\n", shift);
   f.printf("rate_hz: %g\nresolution: [%d, %d]\ncamera_model: pinhole\n", seq.options().fps, cam.width, cam.height);
-  f.printf("intrinsics: [%.9g, %.9g, %.9g, %.9g] #fu, fv, cu, cv\n", cam.fx, cam.fy, cam.cx, cam.cy);
+  f.puts("intrinsics: [" + yamlReal(cam.fx) + ", " + yamlReal(cam.fy) + ", " + yamlReal(cam.cx) + ", " +
+         yamlReal(cam.cy) + "] #fu, fv, cu, cv\n");
   f.puts("distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n");
   f.close();
 }
@@ -135,18 +145,20 @@ void writeSynthSettings(const fs::path& file, const SyntheticSequence& seq, std:
   f.printf("Sensor: \"%s\"\n", std::string(sensor).c_str());
   // The system's seed is a 31-bit integer in the settings; the scene seed is folded into it.
   f.printf("System.seed: %llu\n\n", static_cast<unsigned long long>(o.seed & 0x7fffffffULL));
-  f.printf("Camera.fx: %.9g\nCamera.fy: %.9g\nCamera.cx: %.9g\nCamera.cy: %.9g\n\n", c.fx, c.fy, c.cx, c.cy);
+  f.puts("Camera.fx: " + yamlReal(c.fx) + "\nCamera.fy: " + yamlReal(c.fy) + "\nCamera.cx: " + yamlReal(c.cx) +
+         "\nCamera.cy: " + yamlReal(c.cy) + "\n\n");
   f.puts("Camera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n\n");
   f.printf("Camera.width: %d\nCamera.height: %d\n\n", c.width, c.height);
-  f.printf("Camera.fps: %.9g\n\n", o.fps);
-  f.puts("# stereo baseline times fx (virtual for RGB-D)\n");
-  f.printf("Camera.bf: %.9g\n\n", c.fx * o.baseline);
+  f.puts("Camera.fps: " + yamlReal(o.fps) + "\n\n");
+  f.puts("# Stereo baseline times fx (virtual for RGB-D).\n");
+  f.puts("Camera.bf: " + yamlReal(c.fx * o.baseline) + "\n\n");
   f.puts("# Colour order of the images (0: BGR, 1: RGB); they are grey.\nCamera.RGB: 1\n\n");
   f.puts("# Close/far threshold, in baselines.\nThDepth: 40.0\n\n");
   if (sensor == "rgbd") f.puts("# Raw depth value / DepthMapFactor = metres.\nDepthMapFactor: 5000.0\n\n");
-  f.printf("ORBextractor.nFeatures: %d\nORBextractor.scaleFactor: %.9g\nORBextractor.nLevels: %d\n"
-           "ORBextractor.iniThFAST: %d\nORBextractor.minThFAST: %d\n",
-           orb.features, static_cast<double>(orb.scaleFactor), orb.levels, orb.iniThFast, orb.minThFast);
+  f.printf("ORBextractor.nFeatures: %d\n", orb.features);
+  f.puts("ORBextractor.scaleFactor: " + yamlReal(std::round(orb.scaleFactor * 1e6) / 1e6) + "\n");
+  f.printf("ORBextractor.nLevels: %d\nORBextractor.iniThFAST: %d\nORBextractor.minThFAST: %d\n", orb.levels,
+           orb.iniThFast, orb.minThFast);
   f.close();
 }
 
