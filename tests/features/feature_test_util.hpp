@@ -15,12 +15,12 @@ namespace orbis::test {
 
 // Random shapes of random grey levels over a random-noise background, lightly blurred: corners
 // everywhere, at many scales. Same seed, same image.
-inline cv::Mat texturedImage(int width, int height, std::uint64_t seed) {
+inline cv::Mat texturedImage(int width, int height, std::uint64_t seed, int pixelsPerShape = 600) {
   cv::RNG rng(seed);
   cv::Mat img(height, width, CV_8UC1);
   rng.fill(img, cv::RNG::UNIFORM, 60, 200);
   cv::GaussianBlur(img, img, cv::Size(0, 0), 4.0);
-  const int shapes = width * height / 600;
+  const int shapes = width * height / pixelsPerShape;
   for (int i = 0; i < shapes; ++i) {
     const cv::Point c(rng.uniform(0, width), rng.uniform(0, height));
     const int size = rng.uniform(3, 28);

@@ -1,0 +1,113 @@
+// orbis/features/frame_features.hpp — everything the tracker keeps of an input frame (paper
+// Fig. 2b): keypoints, descriptors, stereo coordinate, depth, and a grid for area queries.
+//
+// Contract: per keypoint i (all arrays the same length): keypoints[i] as detected (raw image),
+// keypointsUn[i] undistorted (equal to keypoints[i] for rectified or undistorted input),
+// descriptors[i], uRight[i] (right-image column of a stereo keypoint, or the virtual one
+// u - bf/d for RGB-D; -1 for a monocular keypoint) and depth[i] (metres, -1 when unknown).
+// kind(i) is Monocular without depth, Close when depth < closeDepth (camera's threshold, 40
+// baselines by default), else Far. The grid indexes keypointsUn over the undistorted image
+// bounds (the undistorted image corners for a distorting lens, the image rectangle otherwise).
+// Builders: extractMonocular, extractStereo (rectified pair; the two extractions run on
+// OpenCV's thread pool), extractRgbd (depth image CV_16U or CV_32F, raw value / depthScale =
+// metres; 0, negative or NaN means no depth). Errors of input type throw orbis::Error.
+#pragma once
+
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "orbis/camera/distortion.hpp"
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/camera/stereo.hpp"
+#include "orbis/features/descriptor.hpp"
+#include "orbis/features/extractor.hpp"
+#include "orbis/features/feature_grid.hpp"
+#include "orbis/features/keypoint.hpp"
+#include "orbis/features/stereo_matcher.hpp"
+
+namespace orbis {
+
+enum class KeypointKind { Monocular, Close, Far };
+
+struct FrameFeatures {
+  std::vector<Keypoint> keypoints;
+  std::vector<Keypoint> keypointsUn;
+  std::vector<OrbDescriptor> descriptors;
+  std::vector<float> uRight;
+  std::vector<float> depth;
+  float closeDepth = std::numeric_limits<float>::infinity();
+  ScaleLevels scales;
+  FeatureGrid grid;
+
+  std::size_t size() const { return keypoints.size(); }
+  bool hasDepth(std::size_t i) const { return depth[i] > 0.f; }
+  KeypointKind kind(std::size_t i) const {
+    if (!hasDepth(i)) return KeypointKind::Monocular;
+    return depth[i] < closeDepth ? KeypointKind::Close : KeypointKind::Far;
+  }
+  std::size_t stereoCount() const;
+};
+
+// Image-bound helpers and the non-template steps of the builders (frame_features.cpp).
+namespace detail {
+struct ImageBounds {
+  float minX, maxX, minY, maxY;
+};
+ImageBounds undistortedBounds(const PinholeCamera<double>& camera, const RadTanDistortion<double>& lens,
+                              int width, int height);
+void finishMonocular(FrameFeatures& f, const PinholeCamera<double>& camera,
+                     const RadTanDistortion<double>& lens, int width, int height);
+void assignDepth(FrameFeatures& f, const cv::Mat& depthImage, double depthScale, double bf);
+}  // namespace detail
+
+template <FeatureExtractor E>
+FrameFeatures extractMonocular(E& extractor, const cv::Mat& image, const PinholeCamera<double>& camera,
+                               const RadTanDistortion<double>& lens = {}) {
+  FrameFeatures f;
+  extractor.extract(image, f.keypoints, f.descriptors);
+  f.scales = extractor.scaleLevels();
+  detail::finishMonocular(f, camera, lens, image.cols, image.rows);
+  return f;
+}
+
+// `matcher` carries reusable buffers; pass the same one every frame.
+template <FeatureExtractor E>
+FrameFeatures extractStereo(E& leftExtractor, E& rightExtractor, const cv::Mat& leftImage,
+                            const cv::Mat& rightImage, const RectifiedStereoCamera<double>& camera,
+                            StereoMatcher& matcher) {
+  FrameFeatures f;
+  std::vector<Keypoint> rightKeypoints;
+  std::vector<OrbDescriptor> rightDescriptors;
+  cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& range) {
+    for (int side = range.start; side < range.end; ++side) {
+      if (side == 0)
+        leftExtractor.extract(leftImage, f.keypoints, f.descriptors);
+      else
+        rightExtractor.extract(rightImage, rightKeypoints, rightDescriptors);
+    }
+  });
+  f.scales = leftExtractor.scaleLevels();
+  f.closeDepth = static_cast<float>(camera.closeDepthThreshold());
+  detail::finishMonocular(f, camera.pinhole, {}, leftImage.cols, leftImage.rows);
+  matcher.match({f.keypoints, f.descriptors, leftExtractor.pyramid()},
+                {rightKeypoints, rightDescriptors, rightExtractor.pyramid()}, f.scales,
+                static_cast<float>(camera.bf()), static_cast<float>(camera.baseline), f.uRight, f.depth);
+  return f;
+}
+
+template <FeatureExtractor E>
+FrameFeatures extractRgbd(E& extractor, const cv::Mat& image, const cv::Mat& depthImage,
+                          const RgbdCamera<double>& camera, const RadTanDistortion<double>& lens = {}) {
+  FrameFeatures f;
+  extractor.extract(image, f.keypoints, f.descriptors);
+  f.scales = extractor.scaleLevels();
+  f.closeDepth = static_cast<float>(camera.closeDepthThreshold());
+  detail::finishMonocular(f, camera.pinhole, lens, image.cols, image.rows);
+  detail::assignDepth(f, depthImage, camera.depthScale, camera.bf());
+  return f;
+}
+
+}  // namespace orbis

@@ -1,0 +1,140 @@
+// Stereo keypoint matching on rectified pairs; see include/orbis/features/stereo_matcher.hpp.
+#include "orbis/features/stereo_matcher.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+
+namespace orbis {
+namespace {
+
+// Sum of absolute differences of two (2h+1)^2 patches, each taken relative to its centre
+// pixel so that a brightness offset between the cameras does not count.
+int centredSad(const std::uint8_t* a, int stepA, const std::uint8_t* b, int stepB, int h) {
+  const int ca = a[0], cb = b[0];
+  int sum = 0;
+  for (int dy = -h; dy <= h; ++dy) {
+    const std::uint8_t* ra = a + dy * stepA;
+    const std::uint8_t* rb = b + dy * stepB;
+    for (int dx = -h; dx <= h; ++dx) sum += std::abs((ra[dx] - ca) - (rb[dx] - cb));
+  }
+  return sum;
+}
+
+}  // namespace
+
+void StereoMatcher::match(const StereoView& left, const StereoView& right, const ScaleLevels& scales,
+                          float bf, float minDepth, std::vector<float>& uRight, std::vector<float>& depth) {
+  const std::size_t n = left.keypoints.size();
+  uRight.assign(n, -1.f);
+  depth.assign(n, -1.f);
+  if (n == 0 || right.keypoints.empty() || left.pyramid.empty() || right.pyramid.empty()) return;
+
+  // Right keypoints indexed by every image row their band covers (flat CSR layout).
+  const int rows = left.pyramid[0].rows;
+  rowStart_.assign(static_cast<std::size_t>(rows) + 1, 0);
+  auto bandOf = [&](const Keypoint& k) {
+    const float r = kRowBand * scales.scale[static_cast<std::size_t>(k.octave)];
+    return std::pair{std::max(0, static_cast<int>(std::floor(k.v - r))),
+                     std::min(rows - 1, static_cast<int>(std::ceil(k.v + r)))};
+  };
+  for (const Keypoint& k : right.keypoints) {
+    const auto [r0, r1] = bandOf(k);
+    for (int y = r0; y <= r1; ++y) ++rowStart_[static_cast<std::size_t>(y) + 1];
+  }
+  for (int y = 0; y < rows; ++y) rowStart_[static_cast<std::size_t>(y) + 1] += rowStart_[static_cast<std::size_t>(y)];
+  rowEntries_.resize(static_cast<std::size_t>(rowStart_.back()));
+  rowFill_.assign(rowStart_.begin(), rowStart_.end() - 1);
+  for (std::size_t i = 0; i < right.keypoints.size(); ++i) {
+    const auto [r0, r1] = bandOf(right.keypoints[i]);
+    for (int y = r0; y <= r1; ++y) rowEntries_[static_cast<std::size_t>(rowFill_[static_cast<std::size_t>(y)]++)] = static_cast<int>(i);
+  }
+
+  const float minDisparity = 0.f;
+  const float maxDisparity = bf / minDepth;
+  costAndIndex_.clear();
+
+  for (std::size_t iL = 0; iL < n; ++iL) {
+    const Keypoint& kl = left.keypoints[iL];
+    const int level = kl.octave;
+    const int row = static_cast<int>(kl.v);
+    if (row < 0 || row >= rows) continue;
+    const float minU = kl.u - maxDisparity, maxU = kl.u - minDisparity;
+    if (maxU < 0.f) continue;
+
+    int bestDistance = kMaxDescriptorDistance;
+    int bestRight = -1;
+    const OrbDescriptor& dl = left.descriptors[iL];
+    for (int e = rowStart_[static_cast<std::size_t>(row)]; e < rowStart_[static_cast<std::size_t>(row) + 1]; ++e) {
+      const int iR = rowEntries_[static_cast<std::size_t>(e)];
+      const Keypoint& kr = right.keypoints[static_cast<std::size_t>(iR)];
+      if (kr.octave < level - 1 || kr.octave > level + 1) continue;
+      if (kr.u < minU || kr.u > maxU) continue;
+      const int d = hammingDistance(dl, right.descriptors[static_cast<std::size_t>(iR)]);
+      if (d < bestDistance) {
+        bestDistance = d;
+        bestRight = iR;
+      }
+    }
+    if (bestRight < 0) continue;
+
+    // Sub-pixel refinement by patch correlation on the left keypoint's level.
+    const float invScale = scales.invScale[static_cast<std::size_t>(level)];
+    const float scale = scales.scale[static_cast<std::size_t>(level)];
+    const cv::Mat& imL = left.pyramid[static_cast<std::size_t>(level)];
+    const cv::Mat& imR = right.pyramid[static_cast<std::size_t>(level)];
+    const int uL = cvRound(kl.u * invScale), vL = cvRound(kl.v * invScale);
+    const int uR0 = cvRound(right.keypoints[static_cast<std::size_t>(bestRight)].u * invScale);
+    if (uR0 - kSlide - kPatchHalf < 0 || uR0 + kSlide + kPatchHalf >= imR.cols) continue;
+    if (vL - kPatchHalf < 0 || vL + kPatchHalf >= imL.rows || uL - kPatchHalf < 0 ||
+        uL + kPatchHalf >= imL.cols)
+      continue;
+    const std::uint8_t* patchL = imL.ptr<std::uint8_t>(vL) + uL;
+    const std::uint8_t* rowR = imR.ptr<std::uint8_t>(vL);
+    const int stepL = static_cast<int>(imL.step), stepR = static_cast<int>(imR.step);
+    int costs[2 * kSlide + 1];
+    int bestCost = INT_MAX, bestShift = 0;
+    for (int s = -kSlide; s <= kSlide; ++s) {
+      const int c = centredSad(patchL, stepL, rowR + uR0 + s, stepR, kPatchHalf);
+      costs[s + kSlide] = c;
+      if (c < bestCost) {
+        bestCost = c;
+        bestShift = s;
+      }
+    }
+    if (bestShift == -kSlide || bestShift == kSlide) continue;  // minimum not bracketed
+
+    const float c1 = static_cast<float>(costs[kSlide + bestShift - 1]);
+    const float c2 = static_cast<float>(costs[kSlide + bestShift]);
+    const float c3 = static_cast<float>(costs[kSlide + bestShift + 1]);
+    const float curvature = 2.f * (c1 + c3 - 2.f * c2);
+    if (curvature <= 0.f) continue;  // flat: no reliable minimum
+    const float delta = (c1 - c3) / curvature;
+    if (delta < -1.f || delta > 1.f) continue;
+
+    float uR = scale * (static_cast<float>(uR0 + bestShift) + delta);
+    float disparity = kl.u - uR;
+    if (disparity < minDisparity || disparity >= maxDisparity) continue;
+    if (disparity <= 0.f) {
+      // A point at infinity: keep it as (nearly) zero disparity rather than lose it.
+      disparity = 0.01f;
+      uR = kl.u - disparity;
+    }
+    uRight[iL] = uR;
+    depth[iL] = bf / disparity;
+    costAndIndex_.emplace_back(bestCost, static_cast<int>(iL));
+  }
+
+  if (costAndIndex_.empty()) return;
+  std::sort(costAndIndex_.begin(), costAndIndex_.end());
+  const float median = static_cast<float>(costAndIndex_[costAndIndex_.size() / 2].first);
+  const float threshold = kOutlierFactor * median;
+  for (auto it = costAndIndex_.rbegin(); it != costAndIndex_.rend(); ++it) {
+    if (static_cast<float>(it->first) <= threshold) break;
+    uRight[static_cast<std::size_t>(it->second)] = -1.f;
+    depth[static_cast<std::size_t>(it->second)] = -1.f;
+  }
+}
+
+}  // namespace orbis
