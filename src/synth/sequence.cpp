@@ -65,14 +65,14 @@ cv::Mat SyntheticSequence::renderImage(int i, const SE3d& leftToCamera, int came
     // Sub-frame instants spread evenly over the open shutter, centred on the frame's instant.
     const double offset = n == 1 ? 0.0 : options_.shutter * ((k + 0.5) / n - 0.5);
     const SE3d subPose = poseAtPhase((i + offset) / options_.frames) * leftToCamera;
-    // Depth belongs to the frame's instant, i.e. the central sub-frame (or the one just past it).
-    const bool centre = k == n / 2;
+    // Depth belongs to the frame's instant: the central sub-frame when there is one.
+    const bool centre = n % 2 == 1 && k == n / 2;
     renderer_.render(scene_, cam, subPose, gray, centre ? depth : nullptr);
     if (k == 0) sum = gray.clone();
     else sum += gray;
   }
   if (n > 1) sum *= 1.0 / n;
-  if (depth && n > 1 && n % 2 == 0) {
+  if (depth && n % 2 == 0) {
     // Even sub-frame counts have no sample at the frame's instant: render its depth separately.
     renderer_.render(scene_, cam, pose(i) * leftToCamera, gray, depth);
   }

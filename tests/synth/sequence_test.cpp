@@ -171,6 +171,13 @@ TEST(SynthSequence, MotionBlurSmoothsAlongTheMotion) {
   b.left.convertTo(fb, CV_32F);
   cv::matchTemplate(fa, fb, result, cv::TM_CCOEFF_NORMED);
   EXPECT_GT(result.at<float>(0, 0), 0.8f);
+  // Depth is the frame's instant, unblurred, for odd and even sub-frame counts alike.
+  const SynthFrame sharpDepth = SyntheticSequence(sharp).render(10, false, true);
+  for (int subframes : {4, 5}) {
+    blurred.blurSubframes = subframes;
+    const SynthFrame f = SyntheticSequence(blurred).render(10, false, true);
+    EXPECT_EQ(cv::norm(f.depth, sharpDepth.depth, cv::NORM_INF), 0.0) << subframes << " sub-frames";
+  }
 }
 
 TEST(SynthSequence, BlackSegmentIsBlackWithInvalidDepthButKeepsItsPose) {

@@ -10,8 +10,8 @@
 // frame's instant (motion blur), plus Gaussian noise of noiseSigma grey levels, rounded and
 // clamped. Frames blackStart .. blackStart+blackCount-1 are all black with zero (invalid)
 // depth, but keep their pose (the camera was covered). Everything is a function of the
-// options and the seed: the same options give byte-identical frames, in any order, and
-// render() is const apart from the scratch buffers of the per-object renderer.
+// options and the seed: the same options give byte-identical frames, in any order (render()
+// changes nothing but its renderer's scratch buffers; use one sequence object per thread).
 #pragma once
 
 #include <cstdint>
