@@ -37,8 +37,9 @@ concept LieGroup = requires(const G g, const typename G::Tangent xi, const typen
   { g.template cast<double>() };
 };
 
-// Groups whose exp has closed-form left/right Jacobians and inverses (SO3, SE3, Sim3):
-//   exp(ξ + δ) ≈ exp(leftJacobian(ξ)·δ)·exp(ξ) ≈ exp(ξ)·exp(rightJacobian(ξ)·δ).
+// Groups that also give the Jacobians of exp and their inverses (SO3, SE3, Sim3):
+//   exp(ξ + δ) ≈ exp(leftJacobian(ξ)·δ)·exp(ξ) ≈ exp(ξ)·exp(rightJacobian(ξ)·δ),
+//   log(exp(δ)·exp(ξ)) ≈ ξ + leftJacobianInverse(ξ)·δ, and likewise on the right.
 template <class G>
 concept LieGroupWithJacobians = LieGroup<G> && requires(const typename G::Tangent xi) {
   { G::leftJacobian(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
@@ -69,6 +70,43 @@ inline S quaternionDriftTolerance() {
 template <>
 inline float quaternionDriftTolerance<float>() {
   return 1e-6f;
+}
+
+// Below this angle a closed form divides 0 by 0 outright; used where the neglected terms are
+// O(θ²) relative and only multiply quantities that are themselves O(θ²).
+template <class S>
+inline S tinyAngle() {
+  return S(1e-7);
+}
+template <>
+inline float tinyAngle<float>() {
+  return 3e-4f;
+}
+
+// φ1(M) = Σ_k M^k/(k+1)! = ∫₀¹ exp(τM) dτ for a fixed-size square M, the left Jacobian of a
+// matrix Lie group when M = ad(ξ). Taylor series on M/2^s (norm ≤ ½, degree 12: truncation
+// below double's ε), then s doublings φ1(2X) = ½(exp(X) + I)·φ1(X), exp(2X) = exp(X)².
+template <class S, int N>
+Eigen::Matrix<S, N, N> phi1(const Eigen::Matrix<S, N, N>& m) {
+  using Matrix = Eigen::Matrix<S, N, N>;
+  const S norm = m.cwiseAbs().rowwise().sum().maxCoeff();
+  int doublings = 0;
+  S shrink(1);
+  while (norm * shrink > S(0.5) && doublings < 60) {
+    shrink /= S(2);
+    ++doublings;
+  }
+  const Matrix x = m * shrink;
+  const Matrix identity = Matrix::Identity();
+  constexpr int kDegree = 12;
+  Matrix p = identity;
+  for (int k = kDegree; k >= 1; --k) p = identity + (x * p) / S(k + 1);  // Horner
+  Matrix e = identity + x * p;                                            // exp(X) = I + X·φ1(X)
+  for (int i = 0; i < doublings; ++i) {
+    p = (S(0.5) * (e + identity) * p).eval();
+    e = (e * e).eval();
+  }
+  return p;
 }
 
 template <class S>
