@@ -28,7 +28,7 @@ void KeyframeDatabase::add(KeyframeId id, const BowVector& bow) {
     slots_.emplace_back();
     index_.emplace(id, slot);
   }
-  slots_[slot] = Slot{id, bow, true};
+  slots_[slot] = Slot{id, bow};
   if (!bow.empty() && bow.entries().back().word >= inverted_.size()) inverted_.resize(bow.entries().back().word + 1);
   for (const WordEntry& e : bow) inverted_[e.word].push_back(slot);
 }

@@ -27,6 +27,18 @@ TEST(Vocabulary, TrainingIsDeterministicAndIndependentOfThreadCount) {
   EXPECT_FALSE(sameBytes(a, test::trainSmall(8, 1))) << "the seed must matter";
 }
 
+TEST(Vocabulary, EmptyVocabularyTransformsToEmptyVectors) {
+  const OrbVocabulary empty;
+  EXPECT_TRUE(empty.empty());
+  const auto images = test::syntheticImages(3, 1, 10, 10, 2);
+  EXPECT_TRUE(empty.transform(images[0]).empty());
+  BowVector bow = BowVector::fromUnsorted({{1, 1.0}}, true);
+  FeatureVector fv;
+  empty.transform(images[0], bow, fv, 2);
+  EXPECT_TRUE(bow.empty());
+  EXPECT_TRUE(fv.empty());
+}
+
 TEST(Vocabulary, TreeShapeRespectsKAndL) {
   const OrbVocabulary v = test::trainSmall(7, 2, 5, 3);
   EXPECT_EQ(v.branching(), 5u);

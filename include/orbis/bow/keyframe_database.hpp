@@ -111,7 +111,6 @@ class KeyframeDatabase {
   struct Slot {
     KeyframeId id = 0;
     BowVector bow;
-    bool live = false;
   };
   struct Scratch {
     std::vector<std::uint32_t> common;   // per slot: words shared with the query

@@ -7,7 +7,9 @@
 // every training image) are dropped. The BowVector is L1-normalised, so score() lies in [0, 1].
 // The FeatureVector groups feature indices by the node at depth L - levelsUp on the descriptor's
 // path (the leaf itself when the leaf is shallower; the root when levelsUp >= L).
-// Thread safety: all member functions are const and may run concurrently.
+// A default-constructed (empty) vocabulary transforms everything to empty vectors; lookup() and
+// the node/word accessors need a loaded one. Thread safety: all members are const and may run
+// concurrently.
 #pragma once
 
 #include <concepts>
@@ -112,6 +114,7 @@ class Vocabulary {
   WordId wordOf(const Descriptor& d) const { return lookup(d).word; }
 
   BowVector transform(std::span<const Descriptor> descriptors) const {
+    if (empty()) return {};
     std::vector<WordEntry> entries;
     entries.reserve(descriptors.size());
     for (const Descriptor& d : descriptors) {
@@ -124,6 +127,9 @@ class Vocabulary {
   // BowVector plus FeatureVector (indices into `descriptors`) in one pass.
   void transform(std::span<const Descriptor> descriptors, BowVector& bow, FeatureVector& features,
                  int levelsUp) const {
+    bow = {};
+    features = {};
+    if (empty()) return;
     std::vector<WordEntry> entries;
     std::vector<std::pair<NodeId, std::uint32_t>> groups;
     entries.reserve(descriptors.size());
