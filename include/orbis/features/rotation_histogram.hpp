@@ -1,0 +1,63 @@
+// orbis/features/rotation_histogram.hpp — rotation-consistency check for a set of matches.
+//
+// Contract: add(angleDifferenceDeg, item) files a match by the difference of its two keypoint
+// orientations into one of kBins bins of 360/kBins degrees; rejected() lists the items outside
+// the three most populated bins (the second and third count only when they hold at least a
+// tenth of the first; ORB-SLAM's rule). A consistent image rotation puts the true matches in
+// one or two neighbouring bins, so what is rejected is mostly wrong. Reusable after clear().
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace orbis {
+
+class RotationHistogram {
+ public:
+  static constexpr int kBins = 30;
+
+  void clear() {
+    for (auto& b : bins_) b.clear();
+  }
+
+  void add(float angleDifferenceDeg, int item) {
+    float a = std::fmod(angleDifferenceDeg, 360.f);
+    if (a < 0.f) a += 360.f;
+    int bin = static_cast<int>(a * (static_cast<float>(kBins) / 360.f));
+    if (bin >= kBins) bin = kBins - 1;
+    bins_[static_cast<std::size_t>(bin)].push_back(item);
+  }
+
+  // Items to drop, appended to `out` (which is not cleared).
+  void rejected(std::vector<int>& out) const {
+    int first = -1, second = -1, third = -1;
+    auto size = [this](int b) { return b < 0 ? 0 : static_cast<int>(bins_[static_cast<std::size_t>(b)].size()); };
+    for (int b = 0; b < kBins; ++b) {
+      const int n = size(b);
+      if (n > size(first)) {
+        third = second;
+        second = first;
+        first = b;
+      } else if (n > size(second)) {
+        third = second;
+        second = b;
+      } else if (n > size(third)) {
+        third = b;
+      }
+    }
+    const float minKept = 0.1f * static_cast<float>(size(first));
+    if (static_cast<float>(size(second)) < minKept) second = third = -1;
+    else if (static_cast<float>(size(third)) < minKept) third = -1;
+    for (int b = 0; b < kBins; ++b) {
+      if (b == first || b == second || b == third) continue;
+      const auto& items = bins_[static_cast<std::size_t>(b)];
+      out.insert(out.end(), items.begin(), items.end());
+    }
+  }
+
+ private:
+  std::array<std::vector<int>, kBins> bins_;
+};
+
+}  // namespace orbis
