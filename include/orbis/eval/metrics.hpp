@@ -1,0 +1,93 @@
+// orbis/eval/metrics.hpp — trajectory error metrics: ATE, RPE and the KITTI odometry metric.
+//
+// Contract:
+//  - computeAte: associate by time (maxDt), align the estimate's positions onto the ground
+//    truth (SE(3) for metric sensors, Sim(3) for monocular, or none), and report statistics of
+//    the per-pose position error in metres, as the TUM benchmark and evo define ATE.
+//  - computeRpe: on the associated (and aligned, if asked; only Sim(3)'s scale matters) poses,
+//    the error of the relative motion between pose i and pose j, where j = i + delta frames,
+//    or the first pose whose ground-truth path length from i reaches delta metres. Translation
+//    part in metres, rotation part in degrees.
+//  - computeKittiMetric: the KITTI devkit's evaluate_odometry on one sequence — from every 10th
+//    frame, segments of 100, 200, ..., 800 m of ground-truth path length; t_rel is the mean of
+//    translation error / length (reported in %), r_rel the mean of rotation angle / length
+//    (reported in deg per 100 m). Pairs are frame-for-frame (devkit semantics).
+// Throws orbis::Error("evaluation") when nothing can be evaluated (no matched pose, no segment).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "orbis/eval/alignment.hpp"
+
+namespace orbis::eval {
+
+struct ErrorStatistics {
+  double rmse = 0, mean = 0, median = 0, max = 0, min = 0, std = 0;
+  std::size_t count = 0;
+};
+// Population standard deviation, as numpy/evo compute it; all zero for an empty input.
+ErrorStatistics computeStatistics(const std::vector<double>& errors);
+
+struct AteOptions {
+  Alignment alignment = Alignment::SE3;
+  double maxDt = 0.02;  // seconds
+};
+struct AteResult {
+  ErrorStatistics stats;        // metres
+  Sim3d alignment;              // maps estimate world → ground-truth world
+  std::vector<PosePair> pairs;  // matched poses
+  std::vector<double> errors;   // per pair, metres
+  Trajectory alignedEstimate;   // the matched estimate poses after alignment
+};
+AteResult computeAte(const Trajectory& groundTruth, const Trajectory& estimate,
+                     const AteOptions& options = {});
+
+enum class DeltaUnit { Frames, Metres };
+struct RpeOptions {
+  double delta = 1.0;
+  DeltaUnit unit = DeltaUnit::Frames;
+  Alignment alignment = Alignment::None;
+  double maxDt = 0.02;
+};
+struct RpeResult {
+  ErrorStatistics translation;  // metres
+  ErrorStatistics rotationDegrees;
+  std::vector<double> times;  // ground-truth time of the pair's first pose
+  std::vector<double> translationErrors;
+  std::vector<double> rotationErrorsDegrees;
+  std::size_t matched = 0;  // associated poses the pairs were drawn from
+};
+RpeResult computeRpe(const Trajectory& groundTruth, const Trajectory& estimate,
+                     const RpeOptions& options = {});
+
+struct KittiSegment {
+  std::size_t firstFrame = 0;
+  double length = 0;            // metres
+  double translationError = 0;  // ratio (metres per metre)
+  double rotationError = 0;     // radians per metre
+  double speed = 0;             // metres per second at KITTI's 10 Hz
+};
+struct KittiLengthSummary {
+  double length = 0;
+  std::size_t segments = 0;
+  double translationPercent = 0;
+  double rotationDegPer100m = 0;
+};
+struct KittiResult {
+  double translationPercent = 0;  // t_rel
+  double rotationDegPer100m = 0;  // r_rel
+  std::vector<KittiSegment> segments;
+  std::vector<KittiLengthSummary> perLength;  // only lengths that have segments
+};
+// groundTruth and estimate are frame-for-frame (same size); lengths default to the devkit's.
+KittiResult computeKittiMetric(const std::vector<SE3d>& groundTruth, const std::vector<SE3d>& estimate,
+                               const std::vector<double>& lengths = {100, 200, 300, 400, 500, 600, 700, 800});
+
+// KITTI devkit helpers, exposed for tests: cumulative path length, and the last frame of the
+// segment starting at `first` (the first frame whose distance exceeds dist[first] + length),
+// or -1 when the trajectory is too short.
+std::vector<double> trajectoryDistances(const std::vector<SE3d>& poses);
+long lastFrameFromSegmentLength(const std::vector<double>& distances, std::size_t first, double length);
+
+}  // namespace orbis::eval
