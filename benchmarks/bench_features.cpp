@@ -17,6 +17,9 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "orbis/camera/euroc_calibration.hpp"
+#include "orbis/camera/rectification.hpp"
+#include "orbis/features/frame_features.hpp"
 #include "orbis/features/orb_extractor.hpp"
 
 
@@ -36,6 +39,8 @@ struct Dataset {
   int features;
   std::vector<cv::Mat> left, right;  // right empty for monocular sources
   float bf = 0.f;
+  std::vector<cv::Mat> rectifiedLeft = {}, rectifiedRight = {};  // stereo sources only
+  float baseline = 0.f;
 };
 
 std::vector<fs::path> sortedPngs(const fs::path& dir, int count) {
@@ -63,6 +68,23 @@ std::vector<Dataset>& datasets() {
                   loadGray(root / "euroc_V1_01_easy_95/mav0/cam1/data", kFrames)};
     Dataset kitti{"KITTI_1226x370", 2000, loadGray(root / "kitti_06_first51/sequences/06/image_0", kFrames),
                   loadGray(root / "kitti_06_first51/sequences/06/image_1", kFrames), 379.8145f};
+    if (!euroc.left.empty() && euroc.left.size() == euroc.right.size()) {
+      // EuRoC is not rectified: rectify the pairs once, outside the timed loops.
+      const fs::path cams = root / "euroc_V1_01_easy_95/mav0";
+      const auto rect = orbis::rectifyStereo(orbis::readEurocCalibration(cams / "cam0/sensor.yaml"),
+                                             orbis::readEurocCalibration(cams / "cam1/sensor.yaml"));
+      euroc.rectifiedLeft.clear();
+      for (std::size_t i = 0; i < euroc.left.size(); ++i) {
+        auto pair = rect.rectify(euroc.left[i], euroc.right[i]);
+        euroc.rectifiedLeft.push_back(pair.left);
+        euroc.rectifiedRight.push_back(pair.right);
+      }
+      euroc.bf = static_cast<float>(rect.camera.bf());
+      euroc.baseline = static_cast<float>(rect.camera.baseline);
+    }
+    kitti.rectifiedLeft = kitti.left;
+    kitti.rectifiedRight = kitti.right;
+    kitti.baseline = 379.8145f / 707.0912f;
     for (auto* d : {&tum, &euroc, &kitti})
       if (!d->left.empty()) out.push_back(std::move(*d));
     return out;
@@ -108,6 +130,52 @@ void BM_CvOrbExtract(benchmark::State& state, std::size_t which) {
     benchmark::DoNotOptimize(desc.data);
   }
   state.counters["keypoints"] = static_cast<double>(total) / static_cast<double>(state.iterations());
+}
+
+// Both images of a rectified pair: extraction and stereo matching (paper Sec. III-A).
+void BM_OrbisStereo(benchmark::State& state, std::size_t which) {
+  const Dataset& d = datasets()[which];
+  orbis::OrbExtractor left(paramsFor(d)), right(paramsFor(d));
+  std::vector<orbis::Keypoint> kl, kr;
+  std::vector<orbis::OrbDescriptor> dl, dr;
+  std::vector<float> uRight, depth;
+  orbis::StereoMatcher matcher;
+  std::size_t frame = 0;
+  double matched = 0, total = 0;
+  for (auto _ : state) {
+    const std::size_t i = frame++ % d.rectifiedLeft.size();
+    left.extract(d.rectifiedLeft[i], kl, dl);
+    right.extract(d.rectifiedRight[i], kr, dr);
+    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), d.bf, d.baseline, uRight, depth);
+    matched += static_cast<double>(std::count_if(uRight.begin(), uRight.end(), [](float u) { return u >= 0; }));
+    total += static_cast<double>(kl.size());
+  }
+  state.counters["matched%"] = 100 * matched / total;
+}
+
+// The same with cv::ORB on both images and OpenCV's brute-force cross-checked matcher, kept
+// when the rows agree within 2 px and the disparity is positive: a plain OpenCV pipeline.
+void BM_CvOrbStereo(benchmark::State& state, std::size_t which) {
+  const Dataset& d = datasets()[which];
+  auto orb = cvOrbFor(d);
+  cv::BFMatcher bf(cv::NORM_HAMMING, true);
+  std::vector<cv::KeyPoint> kl, kr;
+  cv::Mat dl, dr;
+  std::vector<cv::DMatch> matches;
+  std::size_t frame = 0;
+  double matched = 0, total = 0;
+  for (auto _ : state) {
+    const std::size_t i = frame++ % d.rectifiedLeft.size();
+    orb->detectAndCompute(d.rectifiedLeft[i], cv::noArray(), kl, dl);
+    orb->detectAndCompute(d.rectifiedRight[i], cv::noArray(), kr, dr);
+    bf.match(dl, dr, matches);
+    for (const cv::DMatch& m : matches) {
+      const cv::Point2f a = kl[static_cast<std::size_t>(m.queryIdx)].pt, b = kr[static_cast<std::size_t>(m.trainIdx)].pt;
+      matched += std::abs(a.y - b.y) < 2.f && a.x >= b.x;
+    }
+    total += static_cast<double>(kl.size());
+  }
+  state.counters["matched%"] = 100 * matched / total;
 }
 
 // Share of 32x32 cells of the image holding at least one keypoint.
@@ -177,6 +245,12 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("Extract/orbis/" + n).c_str(), BM_OrbisExtract, i)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("Extract/cvORB/" + n).c_str(), BM_CvOrbExtract, i)->Unit(benchmark::kMillisecond);
   }
+  for (std::size_t i = 0; i < datasets().size(); ++i) {
+    if (datasets()[i].rectifiedLeft.empty()) continue;
+    const std::string& n = datasets()[i].name;
+    benchmark::RegisterBenchmark(("Stereo/orbis/" + n).c_str(), BM_OrbisStereo, i)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("Stereo/cvORB/" + n).c_str(), BM_CvOrbStereo, i)->Unit(benchmark::kMillisecond);
+  }
   benchmark::Initialize(&argc, argv);
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
@@ -186,6 +260,10 @@ int main(int argc, char** argv) {
     const auto b = reporter.times.find("Extract/cvORB/" + d.name);
     if (a != reporter.times.end() && b != reporter.times.end())
       std::printf("%-16s extraction %.3f\n", d.name.c_str(), a->second / b->second);
+    const auto c = reporter.times.find("Stereo/orbis/" + d.name);
+    const auto e = reporter.times.find("Stereo/cvORB/" + d.name);
+    if (c != reporter.times.end() && e != reporter.times.end())
+      std::printf("%-16s stereo pair (2 extractions + matching) %.3f\n", d.name.c_str(), c->second / e->second);
   }
   printCoverage();
   benchmark::Shutdown();
