@@ -8,6 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
+#include <unistd.h>
+
 #include "orbis/adapters/dataset.hpp"
 #include "orbis/util/error.hpp"
 
@@ -18,9 +20,10 @@ namespace fs = std::filesystem;
 class CorruptInputs : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ =
-        fs::temp_directory_path() /
-        ("orbis_adapters_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    // One folder per test and process: ctest runs the tests of this fixture in parallel.
+    root_ = fs::temp_directory_path() /
+            ("orbis_adapters_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(root_);
     fs::create_directories(root_);
   }

@@ -7,6 +7,9 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <string>
+
+#include <unistd.h>
 
 #include "orbis/util/error.hpp"
 
@@ -34,7 +37,10 @@ orbis::eval::EvaluationPlot circlePlot() {
 class PlotTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "orbis_plot_test";
+    // One folder per test and process: ctest runs the tests of this fixture in parallel.
+    dir_ = fs::temp_directory_path() /
+           ("orbis_plot_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
