@@ -74,6 +74,8 @@ int runEval(const std::vector<std::string>& args) {
       .option("--delta", "N", "rpe: distance between the two poses of a pair", "1")
       .option("--delta-unit", "U", "rpe: frames or m", "frames")
       .flag("--json", "print one JSON object on standard output instead of a table")
+      .option("--gt-times", "FILE", "timestamps for a KITTI-format GT (times.txt); default: frame index")
+      .option("--est-times", "FILE", "timestamps for a KITTI-format EST; default: frame index")
       .option("--plot", "FILE",
               "draw the estimate over the ground truth and the error over time (.png or .svg)");
   if (!parser.parse(args)) return 0;
@@ -87,8 +89,8 @@ int runEval(const std::vector<std::string>& args) {
     return f ? parseTrajectoryFormat(*f, "argument --format") : detectTrajectoryFormat(path);
   };
   const TrajectoryFormat gtFormat = formatOf(gtPath), estFormat = formatOf(estPath);
-  const Trajectory gt = readTrajectory(gtPath, gtFormat);
-  const Trajectory est = readTrajectory(estPath, estFormat);
+  const Trajectory gt = readTrajectory(gtPath, gtFormat, parser.getOptional("--gt-times").value_or(""));
+  const Trajectory est = readTrajectory(estPath, estFormat, parser.getOptional("--est-times").value_or(""));
   const auto alignName = parser.getOptional("--align");
   const eval::Alignment align = alignName         ? eval::parseAlignment(*alignName, "argument --align")
                                 : metric == "ate" ? eval::Alignment::SE3
