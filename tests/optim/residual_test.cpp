@@ -75,6 +75,27 @@ TEST(OptimResiduals, RelativePoseSE3Jacobians) {
   EXPECT_LT(worst, 1e-6);
 }
 
+Sim3d randomSim3(std::mt19937& rng, double rotation, double translation, double logScale) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Sim3d::Tangent xi;
+  for (int k = 0; k < 3; ++k) xi[k] = translation * n(rng);
+  for (int k = 3; k < 6; ++k) xi[k] = rotation * n(rng);
+  xi[6] = logScale * n(rng);
+  return Sim3d::exp(xi);
+}
+
+TEST(OptimResiduals, RelativePoseSim3Jacobians) {
+  std::mt19937 rng(7);
+  double worst = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const RelativePoseSim3 residual{randomSim3(rng, 0.7, 1.0, 0.3)};
+    const auto d = test::checkJacobians(residual, randomSim3(rng, 0.7, 2.0, 0.3), randomSim3(rng, 0.7, 2.0, 0.3));
+    worst = std::max(worst, d.relative());
+  }
+  std::printf("RelativePoseSim3 (7x7x7): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
 TEST(OptimResiduals, JacobianCheckDetectsAWrongJacobian) {
   // The harness itself must be able to fail: a residual with a deliberately wrong sign.
   struct Wrong : MonoReprojection {

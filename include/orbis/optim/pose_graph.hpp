@@ -4,10 +4,11 @@
 // Contract: poses are camera-from-world; an edge (i, j) carries T_ij = T_iw·T_jw⁻¹ as measured
 // before the loop correction, and an isotropic information weight. Fixed poses (at least one,
 // usually the loop keyframe) are never written. ORB-SLAM runs 20 LM iterations; that is the
-// default here. Stereo/RGB-D maps use SE(3); monocular maps Sim(3) (sim3_pose_graph.hpp).
+// default here. Stereo/RGB-D maps use SE(3); monocular maps Sim(3), whose edges carry S_ij.
 #pragma once
 
 #include "orbis/geometry/se3.hpp"
+#include "orbis/geometry/sim3.hpp"
 #include "orbis/optim/solver_options.hpp"
 
 #include <span>
@@ -22,6 +23,13 @@ struct PoseGraphEdgeSE3 {
   double information = 1.0;
 };
 
+struct PoseGraphEdgeSim3 {
+  int i = 0;
+  int j = 0;
+  Sim3d relative;  // S_ij
+  double information = 1.0;
+};
+
 inline SolverOptions essentialGraphOptions() {
   SolverOptions options;
   options.maxIterations = 20;
@@ -30,6 +38,10 @@ inline SolverOptions essentialGraphOptions() {
 
 SolverSummary optimizePoseGraph(std::vector<SE3d>& cameraFromWorld, const std::vector<char>& fixed,
                                 std::span<const PoseGraphEdgeSE3> edges,
+                                const SolverOptions& options = essentialGraphOptions());
+
+SolverSummary optimizePoseGraph(std::vector<Sim3d>& cameraFromWorld, const std::vector<char>& fixed,
+                                std::span<const PoseGraphEdgeSim3> edges,
                                 const SolverOptions& options = essentialGraphOptions());
 
 }  // namespace orbis::optim
