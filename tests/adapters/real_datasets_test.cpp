@@ -1,5 +1,6 @@
 // Every frame of each real sequence in ../shared/datasets read through the adapters; frame
 // counts, stereo/depth completeness and ground-truth coverage printed and checked.
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -142,6 +143,28 @@ TEST(RealDatasets, EurocGroundTruthIsTheLeftCameraPose) {
   const Eigen::Vector3d opticalAxisInBody =
       body[0].pose.rotationMatrix().transpose() * reader->groundTruth()[0].pose.rotationMatrix().col(2);
   EXPECT_GT(opticalAxisInBody.z(), 0.99);
+}
+
+TEST(RealDatasets, EurocRectifiedGroundTruthKeepsTheCentreAndTurnsByTheRectification) {
+  ORBIS_REQUIRE_DATASET(root, "euroc_V1_01_easy_95");
+  orbis::DatasetOptions raw;
+  raw.rectify = false;
+  raw.sensor = orbis::SensorKind::Monocular;
+  const auto unrectified = orbis::openDataset(orbis::DatasetKind::Euroc, root, raw);
+  const auto rectified = orbis::openDataset(orbis::DatasetKind::Euroc, root);
+  const auto& a = unrectified->groundTruth();
+  const auto& b = rectified->groundTruth();
+  ASSERT_EQ(a.size(), b.size());
+  // The same rotation R1^T between the raw and the rectified left camera at every pose: small
+  // (the VI-sensor is nearly rectified already) but not zero.
+  const Eigen::Matrix3d rawFromRectified = a[0].pose.rotationMatrix().transpose() * b[0].pose.rotationMatrix();
+  const double angle = Eigen::AngleAxisd(rawFromRectified).angle();
+  EXPECT_GT(angle, 1e-4);
+  EXPECT_LT(angle, 0.05);
+  for (std::size_t i = 0; i < a.size(); i += 101) {
+    EXPECT_LT((a[i].pose.translation() - b[i].pose.translation()).norm(), 1e-12);
+    EXPECT_TRUE((a[i].pose.rotationMatrix().transpose() * b[i].pose.rotationMatrix()).isApprox(rawFromRectified, 1e-9));
+  }
 }
 
 TEST(RealDatasets, KittiAllStereoPairs) {
