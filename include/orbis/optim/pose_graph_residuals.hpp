@@ -14,36 +14,26 @@
 
 namespace orbis::optim {
 
-struct RelativePoseSE3 {
-  using PoseManifold = SE3Manifold;
-  static constexpr int kDim = 6;
+// One residual for both groups: Manifold is SE3Manifold or Sim3Manifold.
+template <class Manifold>
+struct RelativePose {
+  using PoseManifold = Manifold;
+  using Group = typename Manifold::Value;
+  static constexpr int kDim = Manifold::kDim;
   static constexpr bool kHasPoint = false;
 
-  SE3d measurement;  // T_ij
+  Group measurement;  // T_ij (or S_ij)
 
-  void evaluate(const SE3d& poseI, const SE3d& poseJ, Eigen::Matrix<double, 6, 1>& r,
-                Eigen::Matrix<double, 6, 6>* jI, Eigen::Matrix<double, 6, 6>* jJ) const {
-    const SE3d inverseMeasurement = measurement.inverse();
+  void evaluate(const Group& poseI, const Group& poseJ, Eigen::Matrix<double, kDim, 1>& r,
+                Eigen::Matrix<double, kDim, kDim>* jI, Eigen::Matrix<double, kDim, kDim>* jJ) const {
+    const Group inverseMeasurement = measurement.inverse();
     r = (inverseMeasurement * poseI * poseJ.inverse()).log();
-    if (jI) *jI = SE3d::leftJacobianInverse(r) * inverseMeasurement.Adj();
-    if (jJ) *jJ = -SE3d::rightJacobianInverse(r);
+    if (jI) *jI = Group::leftJacobianInverse(r) * inverseMeasurement.Adj();
+    if (jJ) *jJ = -Group::rightJacobianInverse(r);
   }
 };
 
-struct RelativePoseSim3 {
-  using PoseManifold = Sim3Manifold;
-  static constexpr int kDim = 7;
-  static constexpr bool kHasPoint = false;
-
-  Sim3d measurement;  // S_ij
-
-  void evaluate(const Sim3d& poseI, const Sim3d& poseJ, Eigen::Matrix<double, 7, 1>& r,
-                Eigen::Matrix<double, 7, 7>* jI, Eigen::Matrix<double, 7, 7>* jJ) const {
-    const Sim3d inverseMeasurement = measurement.inverse();
-    r = (inverseMeasurement * poseI * poseJ.inverse()).log();
-    if (jI) *jI = Sim3d::leftJacobianInverse(r) * inverseMeasurement.Adj();
-    if (jJ) *jJ = -Sim3d::rightJacobianInverse(r);
-  }
-};
+using RelativePoseSE3 = RelativePose<SE3Manifold>;
+using RelativePoseSim3 = RelativePose<Sim3Manifold>;
 
 }  // namespace orbis::optim
