@@ -51,17 +51,17 @@ SyntheticStereoStats runSynthetic(int rightBudget) {
 
 TEST(StereoMatcher, SyntheticSequenceDisparityAndShare) {
   const SyntheticStereoStats same = runSynthetic(1000);
-  const SyntheticStereoStats wider = runSynthetic(2000);
-  for (const auto& [name, s] : {std::pair{"same budget", same}, std::pair{"right budget x2", wider}})
+  const SyntheticStereoStats wider = runSynthetic(3000);
+  for (const auto& [name, s] : {std::pair{"same budget", same}, std::pair{"right budget x3", wider}})
     std::printf("[ stereo   ] synth room, 3 frames, %s: %zu of %zu left keypoints matched (%.1f%%), "
                 "median |disparity - bf/Z| %.3f px\n", name, s.matched, s.keypoints, 100 * s.share, s.medianError);
   EXPECT_LT(same.medianError, 0.3);
   EXPECT_LT(wider.medianError, 0.3);
-  // The goal is 70%; measured 55% (same budget) and 65% (right x2) on these frames:
-  // the quadtree keeps different corners in the two views, and ORB-SLAM's median rule drops
-  // the patches with the highest correlation cost. The bounds guard against regressions.
+  // With ORB-SLAM's equal budgets about 55% match: the quadtree keeps different corners in the
+  // two views, so many left keypoints have no partner to find. Three times the budget on the
+  // right gives most of them one (over 70%); the median rule still drops ~10%.
   EXPECT_GT(same.share, 0.5);
-  EXPECT_GT(wider.share, 0.6);
+  EXPECT_GT(wider.share, 0.7);
   EXPECT_GT(wider.share, same.share);
 }
 

@@ -73,7 +73,10 @@ FrameFeatures extractMonocular(E& extractor, const cv::Mat& image, const Pinhole
   return f;
 }
 
-// `matcher` carries reusable buffers; pass the same one every frame.
+// `matcher` carries reusable buffers; pass the same one every frame. The right extractor may
+// have a larger budget than the left: the quadtree keeps different corners in the two views,
+// so more right keypoints give more left keypoints a partner (on the synthetic room sequence
+// 55% of left keypoints match with equal budgets, 71% with three times the budget on the right).
 template <FeatureExtractor E>
 FrameFeatures extractStereo(E& leftExtractor, E& rightExtractor, const cv::Mat& leftImage,
                             const cv::Mat& rightImage, const RectifiedStereoCamera<double>& camera,
