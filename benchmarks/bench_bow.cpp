@@ -4,6 +4,7 @@
 //    orbis binary file vs the same tree parsed from DBoW2's text format, by our parser
 //    (from_chars over one buffer) and by a DBoW2-style parser (getline + stringstream per line,
 //    what ORB-SLAM2 does). Wall-clock time: loading is page-cache and memory bound.
+//  - transform of one keyframe's 1,000 descriptors (shipped tree vs the 1M-word tree).
 //  - keyframe database: relocalisation and loop queries with 1,000 and 10,000 keyframes.
 //  - 1,000 ORB descriptors matched against a 50,000-descriptor set: FLANN (hierarchical
 //    clustering at several search efforts, and LSH) vs exhaustive Hamming, with recall.
@@ -12,6 +13,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -288,11 +290,30 @@ void BM_MatchFlann(benchmark::State& state, BinaryIndexParams::Algorithm algorit
   if (!d) return state.SkipWithError("tum_fr3_teddy_200 not found");
   BinaryIndexParams p;
   p.algorithm = algorithm;
+  if (state.range(1) > 0) p.trees = static_cast<int>(state.range(1));
+  const auto t0 = std::chrono::steady_clock::now();
   const BinaryDescriptorIndex index(d->indexed, p);
+  state.counters["build_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const int checks = static_cast<int>(state.range(0));
   std::vector<DescriptorMatch> got;
   for (auto _ : state) got = index.nearest(d->queries, checks);
   state.counters["recall"] = recall(*d, got);
+}
+
+// One keyframe's transform (1,000 real ORB descriptors) through the shipped tree and through
+// the 1M-word tree: the cost per keyframe ORB-SLAM pays for BoW, and how it grows with L.
+void BM_Transform(benchmark::State& state, bool big) {
+  const MatchData* d = matchData();
+  if (!d) return state.SkipWithError("tum_fr3_teddy_200 not found");
+  if (!big && !fs::exists(shippedVocabulary())) return state.SkipWithError("shipped vocabulary not found");
+  const OrbVocabulary v = big ? OrbVocabulary::load(bigBinary()) : OrbVocabulary::load(shippedVocabulary());
+  BowVector bow;
+  FeatureVector features;
+  for (auto _ : state) {
+    v.transform(d->queries, bow, features, 3);
+    benchmark::DoNotOptimize(bow.entries().data());
+  }
+  state.counters["words"] = static_cast<double>(bow.size());
 }
 
 class RatioReporter : public benchmark::ConsoleReporter {
@@ -324,29 +345,34 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("Load/1M/text_orbis", BM_Load1M_TextOrbis)->Unit(benchmark::kMillisecond)->UseRealTime();
   benchmark::RegisterBenchmark("Load/1M/text_iostream", BM_Load1M_TextIostream)
       ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+  benchmark::RegisterBenchmark("Transform/shipped", BM_Transform, false)->Unit(benchmark::kMicrosecond);
+  benchmark::RegisterBenchmark("Transform/1M", BM_Transform, true)->Unit(benchmark::kMicrosecond);
   benchmark::RegisterBenchmark("Database/reloc", BM_DatabaseQuery, false)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
   benchmark::RegisterBenchmark("Database/loop", BM_DatabaseQuery, true)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
   benchmark::RegisterBenchmark("Match/bruteforce", BM_MatchBruteForce)->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("Match/flann_hc", BM_MatchFlann, BinaryIndexParams::Algorithm::HierarchicalClustering)
-      ->Arg(32)->Arg(64)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond);
+      ->ArgNames({"checks", "trees"})
+      ->Args({32, 4})->Args({64, 4})->Args({128, 4})->Args({256, 4})->Args({512, 4})
+      ->Args({256, 1})->Args({512, 1})->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("Match/flann_lsh", BM_MatchFlann, BinaryIndexParams::Algorithm::Lsh)
-      ->Arg(0)->Unit(benchmark::kMillisecond);
+      ->Args({0, 0})->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   std::printf("\nRatios (same run)\n");
   const auto line = [&](const std::string& what, const std::string& a, const std::string& b) {
-    std::printf("  %-48s %s\n", what.c_str(), reporter.ratio(a, b).c_str());
+    std::printf("  %-62s %s\n", what.c_str(), reporter.ratio(a, b).c_str());
   };
   line("1M-word load, text (orbis parser) / binary:", "Load/1M/text_orbis/real_time", "Load/1M/binary/real_time");
   line("1M-word load, text (DBoW2 iostream) / binary:", "Load/1M/text_iostream/iterations:2/real_time",
        "Load/1M/binary/real_time");
+  line("transform of 1,000 descriptors, 1M / shipped:", "Transform/1M", "Transform/shipped");
   line("database reloc query, 10k / 1k keyframes:", "Database/reloc/10000", "Database/reloc/1000");
   line("database loop query, 10k / 1k keyframes:", "Database/loop/10000", "Database/loop/1000");
-  for (int checks : {32, 64, 128, 256, 512})
-    line("brute force / FLANN hierarchical, checks " + std::to_string(checks) + ":", "Match/bruteforce",
-         "Match/flann_hc/" + std::to_string(checks));
-  line("brute force / FLANN LSH:", "Match/bruteforce", "Match/flann_lsh/0");
+  for (const auto [checks, trees] : {std::pair{32, 4}, {64, 4}, {128, 4}, {256, 4}, {512, 4}, {256, 1}, {512, 1}})
+      line("brute force / FLANN hierarchical, " + std::to_string(trees) + " tree(s), checks " + std::to_string(checks) + ":",
+           "Match/bruteforce", "Match/flann_hc/checks:" + std::to_string(checks) + "/trees:" + std::to_string(trees));
+  line("brute force / FLANN LSH:", "Match/bruteforce", "Match/flann_lsh/0/0");
   benchmark::Shutdown();
   return 0;
 }
