@@ -127,7 +127,7 @@ class LieGroupTest : public ::testing::Test {
     for (int i = 0; i < 40; ++i) out.push_back(makeTangent<G>(rng, angle(rng), 2.0));
     for (int i = 0; i < 5; ++i) out.push_back(makeTangent<G>(rng, kPi - 1e-6, 2.0));
     for (int i = 0; i < 5; ++i) out.push_back(makeTangent<G>(rng, 0.0, 2.0));  // pure translation
-    const double threshold = double(lie_detail::smallAngle<S>());
+    const double threshold = double(lie_detail::Numerics<S>::smallAngle());
     out.push_back(makeTangent<G>(rng, 0.999 * threshold, 2.0));
     out.push_back(makeTangent<G>(rng, 1.001 * threshold, 2.0));
     appendScaleCases(out, kPi - 1e-6);
@@ -138,10 +138,11 @@ class LieGroupTest : public ::testing::Test {
   // tangents on both sides of each switch. No-op for the other groups.
   void appendScaleCases(std::vector<Tangent>& out, double nearPi) {
     if constexpr (G::kDoF == 7) {
-      const double tiny = double(lie_detail::tinyAngle<S>());
-      const double cases[][2] = {{0.0, 1.0},   {0.5 * tiny, 0.8},  {2.0 * tiny, 0.8}, {0.3, 0.199},
-                                 {0.3, 0.201}, {0.6, 0.0},         {0.6, 0.5 * tiny}, {0.6, -2.0 * tiny},
-                                 {0.0, -1.5},  {nearPi, -0.7},     {1e-9, 1e-9}};
+      const double tiny = double(lie_detail::Numerics<S>::tinyAngle());
+      const double cases[][2] = {{0.0, 1.0},        {0.5 * tiny, 0.8},  {2.0 * tiny, 0.8},
+                                 {0.3, 0.199},      {0.3, 0.201},       {0.6, 0.0},
+                                 {0.6, 0.5 * tiny}, {0.6, -2.0 * tiny}, {0.0, -1.5},
+                                 {nearPi, -0.7},    {1e-9, 1e-9}};
       for (const auto& [angle, sigma] : cases) {
         Tangent xi = makeTangent<G>(rng, angle, 1.0);
         xi[6] = S(sigma);
@@ -158,7 +159,7 @@ class LieGroupTest : public ::testing::Test {
     for (int i = 0; i < 20; ++i) out.push_back(makeTangent<G>(rng, angle(rng), 1.5));
     out.push_back(makeTangent<G>(rng, 1e-9, 1.5));
     out.push_back(makeTangent<G>(rng, 1e-9, 1e-9));
-    const double threshold = double(lie_detail::smallAngle<S>());
+    const double threshold = double(lie_detail::Numerics<S>::smallAngle());
     out.push_back(makeTangent<G>(rng, 0.999 * threshold, 1.5));
     out.push_back(makeTangent<G>(rng, 1.001 * threshold, 1.5));
     out.push_back(makeTangent<G>(rng, kPi - 1e-3, 1.5));
@@ -175,7 +176,8 @@ class LieGroupTest : public ::testing::Test {
       const auto n = numeric(xi.template cast<double>().eval());
       const double diff = (a - n).cwiseAbs().maxCoeff();
       EXPECT_LT(diff, Tol<S>::jacobian) << name << " at xi = " << xi.transpose() << "\nanalytic\n"
-                                        << a << "\nnumeric\n" << n;
+                                        << a << "\nnumeric\n"
+                                        << n;
       worst = std::max(worst, diff);
     }
     std::cout << "[jacobian] " << groupName<G>() << " " << name << " max|diff| = " << worst
@@ -240,7 +242,8 @@ TYPED_TEST(LieGroupTest, ExpLogNearIdentityIsRelativelyExact) {
       EXPECT_LT(std::abs(double(back[6] - xi[6])), 2 * eps);
       back[6] = xi[6];
     }
-    const double rel = (back - xi).template cast<double>().norm() / xi.template cast<double>().norm();
+    const double rel =
+        (back - xi).template cast<double>().norm() / xi.template cast<double>().norm();
     EXPECT_LT(rel, Tol<Scalar<G>>::relative) << "xi = " << xi.transpose();
   }
   EXPECT_EQ(G::exp(G::Tangent::Zero()).log(), G::Tangent::Zero());
@@ -252,7 +255,8 @@ TYPED_TEST(LieGroupTest, ExpMatchesMatrixExponentialOfHat) {
   for (const auto& xi : this->roundTripTangents()) {
     const auto xd = xi.template cast<double>().eval();
     const auto expected = GD::hat(xd).exp().eval();
-    const double diff = (G::exp(xi).matrix().template cast<double>() - expected).cwiseAbs().maxCoeff();
+    const double diff =
+        (G::exp(xi).matrix().template cast<double>() - expected).cwiseAbs().maxCoeff();
     EXPECT_LT(diff, 20 * Tol<Scalar<G>>::value) << "xi = " << xi.transpose();
   }
 }
@@ -296,6 +300,91 @@ TYPED_TEST(LieGroupTest, CastPreservesElement) {
   EXPECT_LT(matrixDistance<G>(back, g), Tol<Scalar<G>>::value);
 }
 
+// Builds a group element from Eigen parts; the non-rotation parts are fixed per group.
+template <class G, class Rotation>
+G fromParts(const Rotation& rotation) {
+  using S = Scalar<G>;
+  const Eigen::Matrix<S, 3, 1> t(S(0.3), S(-1.2), S(2.5));
+  if constexpr (G::kDoF == 3) {
+    return G(rotation);
+  } else if constexpr (G::kDoF == 6) {
+    return G(rotation, t);
+  } else {
+    return G(S(1.7), rotation, t);
+  }
+}
+
+TYPED_TEST(LieGroupTest, FromMatrixRoundTrip) {
+  using G = TypeParam;
+  const double tol = Tol<Scalar<G>>::value;
+  for (int i = 0; i < 20; ++i) {
+    const G g = randomElement<G>(this->rng);
+    EXPECT_LT(matrixDistance<G>(G::fromMatrix(g.matrix()), g), 10 * tol);
+    if constexpr (G::kMatrixDim == 4) {
+      EXPECT_LT(matrixDistance<G>(G::fromMatrix(g.matrix3x4()), g), 10 * tol);
+    }
+  }
+}
+
+TYPED_TEST(LieGroupTest, AccessorsMatchMatrix) {
+  using G = TypeParam;
+  const double tol = Tol<Scalar<G>>::value;
+  for (int i = 0; i < 10; ++i) {
+    const G g = randomElement<G>(this->rng);
+    const auto m = g.matrix().template cast<double>().eval();
+    if constexpr (G::kDoF == 3) {
+      EXPECT_LT(
+          (g.unitQuaternion().toRotationMatrix().template cast<double>() - m).cwiseAbs().maxCoeff(),
+          tol);
+    } else {
+      double scale = 1.0;
+      if constexpr (G::kDoF == 7) scale = double(g.scale());
+      EXPECT_LT((scale * g.rotationMatrix().template cast<double>() - m.template block<3, 3>(0, 0))
+                    .cwiseAbs()
+                    .maxCoeff(),
+                10 * tol);
+      EXPECT_LT((g.so3().matrix() - g.rotationMatrix()).cwiseAbs().maxCoeff(), tol);
+      const Eigen::Vector3d translationColumn = m.template block<3, 1>(0, 3);
+      EXPECT_EQ(g.translation().template cast<double>(), translationColumn);
+      EXPECT_EQ(m.row(3), Eigen::RowVector4d(0, 0, 0, 1));
+    }
+  }
+}
+
+TYPED_TEST(LieGroupTest, ConstructionRenormalisesRotation) {
+  using G = TypeParam;
+  using S = Scalar<G>;
+  const double tol = Tol<S>::value;
+  const G reference = randomElement<G>(this->rng);
+  const Eigen::Quaternion<S> unit = reference.unitQuaternion();
+  Eigen::Quaternion<S> scaled = unit;
+  scaled.coeffs() *= S(1.7);
+  const G fromQuaternion = fromParts<G>(scaled);
+  EXPECT_NEAR(double(fromQuaternion.unitQuaternion().norm()), 1.0, tol);
+  EXPECT_LT(matrixDistance<G>(fromQuaternion, fromParts<G>(unit)), 10 * tol);
+
+  // A rotation matrix with 1e-4 of noise becomes a nearby exact rotation.
+  std::uniform_real_distribution<double> noise(-1e-4, 1e-4);
+  Eigen::Matrix<S, 3, 3> noisy = unit.toRotationMatrix();
+  for (int i = 0; i < 9; ++i) noisy(i / 3, i % 3) += S(noise(this->rng));
+  const G fromNoisy = fromParts<G>(noisy);
+  const auto R = fromNoisy.unitQuaternion().toRotationMatrix().template cast<double>().eval();
+  EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 10 * tol);
+  EXPECT_LT(matrixDistance<G>(fromNoisy, fromParts<G>(unit)), 1e-3);
+}
+
+TYPED_TEST(LieGroupTest, LongProductsStayNormalised) {
+  using G = TypeParam;
+  using S = Scalar<G>;
+  G product;
+  for (int i = 0; i < 20000; ++i) product = product * G::exp(makeTangent<G>(this->rng, 0.3, 0.01));
+  const double drift = std::abs(double(product.unitQuaternion().squaredNorm()) - 1.0);
+  EXPECT_LT(drift, 2.0 * double(lie_detail::Numerics<S>::quaternionDrift()));
+  product.normalize();
+  EXPECT_NEAR(double(product.unitQuaternion().norm()), 1.0,
+              4 * double(std::numeric_limits<S>::epsilon()));
+}
+
 TYPED_TEST(LieGroupTest, LeftJacobian) {
   using G = TypeParam;
   using GD = DoubleOf<G>;
@@ -303,8 +392,9 @@ TYPED_TEST(LieGroupTest, LeftJacobian) {
       "leftJacobian", [](const auto& xi) { return G::leftJacobian(xi); },
       [](const typename GD::Tangent& xi) {
         const GD base = GD::exp(xi);
-        return numericJacobian<G::kDoF, G::kDoF>(
-            [&](const typename GD::Tangent& d) { return (GD::exp(xi + d) * base.inverse()).log(); });
+        return numericJacobian<G::kDoF, G::kDoF>([&](const typename GD::Tangent& d) {
+          return (GD::exp(xi + d) * base.inverse()).log();
+        });
       });
 }
 
@@ -357,7 +447,8 @@ TYPED_TEST(LieGroupTest, PointJacobianLeft) {
       [&](const auto& xi) { return G::pointJacobianLeft(G::exp(xi) * pointFor(xi)); },
       [&](const typename GD::Tangent& xi) {
         const typename GD::Point q = GD::exp(xi) * pointFor(xi);
-        return numericJacobian<3, G::kDoF>([&](const typename GD::Tangent& d) { return GD::exp(d) * q; });
+        return numericJacobian<3, G::kDoF>(
+            [&](const typename GD::Tangent& d) { return GD::exp(d) * q; });
       });
 }
 

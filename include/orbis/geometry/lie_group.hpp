@@ -30,7 +30,9 @@ concept LieGroup = requires(const G g, const typename G::Tangent xi, const typen
   { g * g } -> std::same_as<G>;
   { g * p } -> std::same_as<typename G::Point>;
   { g.matrix() } -> std::same_as<typename G::Transformation>;
-  { g.Adj() } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  requires std::same_as<typename G::AdjointMatrix,
+                        Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  { g.Adj() } -> std::same_as<typename G::AdjointMatrix>;
   { G::hat(xi) } -> std::same_as<typename G::Transformation>;
   { G::vee(m) } -> std::same_as<typename G::Tangent>;
   { G::pointJacobianLeft(p) } -> std::same_as<Eigen::Matrix<typename G::Scalar, 3, G::kDoF>>;
@@ -42,46 +44,33 @@ concept LieGroup = requires(const G g, const typename G::Tangent xi, const typen
 //   log(exp(δ)·exp(ξ)) ≈ ξ + leftJacobianInverse(ξ)·δ, and likewise on the right.
 template <class G>
 concept LieGroupWithJacobians = LieGroup<G> && requires(const typename G::Tangent xi) {
-  { G::leftJacobian(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
-  { G::leftJacobianInverse(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
-  { G::rightJacobian(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
-  { G::rightJacobianInverse(xi) } -> std::same_as<Eigen::Matrix<typename G::Scalar, G::kDoF, G::kDoF>>;
+  { G::leftJacobian(xi) } -> std::same_as<typename G::AdjointMatrix>;
+  { G::leftJacobianInverse(xi) } -> std::same_as<typename G::AdjointMatrix>;
+  { G::rightJacobian(xi) } -> std::same_as<typename G::AdjointMatrix>;
+  { G::rightJacobianInverse(xi) } -> std::same_as<typename G::AdjointMatrix>;
 };
 
 namespace lie_detail {
 
-// Below this angle the closed forms lose digits to cancellation (the worst, (2θ−3sinθ+θcosθ)/θ⁵
-// in SE3's Q, loses ~ε/θ absolute), so Taylor series to θ⁴ take over; their truncation error is
-// below ε at the threshold. float needs a much larger threshold than double.
+// Where the numerics switch, per scalar type (float needs far larger thresholds than double).
+//  smallAngle: below it the closed forms lose digits to cancellation (the worst,
+//    (2θ−3sinθ+θcosθ)/θ⁵ in SE3's Q, loses ~ε/θ absolute), so Taylor series to θ⁴ take over;
+//    their truncation error is below ε there.
+//  tinyAngle: below it a closed form is 0/0 outright; the θ → 0 limit replaces it where the
+//    neglected terms are O(θ²) relative and multiply quantities that are themselves O(θ²).
+//  quaternionDrift: how far |q|² may stray from 1 before a product renormalises.
 template <class S>
-inline S smallAngle() {
-  return S(1e-2);
-}
+struct Numerics {
+  static S smallAngle() { return S(1e-2); }
+  static S tinyAngle() { return S(1e-7); }
+  static S quaternionDrift() { return S(1e-12); }
+};
 template <>
-inline float smallAngle<float>() {
-  return 0.25f;
-}
-
-// How far |q|² may drift from 1 before a product renormalises (a few ulps of accumulated rounding).
-template <class S>
-inline S quaternionDriftTolerance() {
-  return S(1e-12);
-}
-template <>
-inline float quaternionDriftTolerance<float>() {
-  return 1e-6f;
-}
-
-// Below this angle a closed form divides 0 by 0 outright; used where the neglected terms are
-// O(θ²) relative and only multiply quantities that are themselves O(θ²).
-template <class S>
-inline S tinyAngle() {
-  return S(1e-7);
-}
-template <>
-inline float tinyAngle<float>() {
-  return 3e-4f;
-}
+struct Numerics<float> {
+  static float smallAngle() { return 0.25f; }
+  static float tinyAngle() { return 3e-4f; }
+  static float quaternionDrift() { return 1e-6f; }
+};
 
 // φ1(M) = Σ_k M^k/(k+1)! = ∫₀¹ exp(τM) dτ for a fixed-size square M, the left Jacobian of a
 // matrix Lie group when M = ad(ξ). Taylor series on M/2^s (norm ≤ ½, degree 12: truncation

@@ -167,7 +167,7 @@ class SE3 {
     using std::sqrt;
     const S theta2 = omega.squaredNorm();
     S c1, c2, c3;
-    if (theta2 < lie_detail::smallAngle<S>() * lie_detail::smallAngle<S>()) {
+    if (theta2 < lie_detail::Numerics<S>::smallAngle() * lie_detail::Numerics<S>::smallAngle()) {
       const S theta4 = theta2 * theta2;
       c1 = S(1) / S(6) - theta2 / S(120) + theta4 / S(5040);
       c2 = S(1) / S(24) - theta2 / S(720) + theta4 / S(40320);

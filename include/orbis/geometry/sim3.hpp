@@ -42,7 +42,8 @@ class Sim3 {
   Sim3(S scale, const Matrix3& rotation, const Vector3& translation)
       : scale_(scale), so3_(rotation), translation_(translation) {}
   // A rigid motion as a similarity of scale 1.
-  explicit Sim3(const SE3<S>& pose) : scale_(1), so3_(pose.so3()), translation_(pose.translation()) {}
+  explicit Sim3(const SE3<S>& pose)
+      : scale_(1), so3_(pose.so3()), translation_(pose.translation()) {}
 
   // Reads the top 3x4 block [s·R | t]; s is the cube root of det(s·R), R is re-normalised.
   template <class Derived>
@@ -60,7 +61,8 @@ class Sim3 {
     using std::exp;
     const S sigma = xi[6];
     const Vector3 omega = xi.template segment<3>(3);
-    return Sim3(exp(sigma), SO3<S>::exp(omega), scaledRotationIntegral(sigma, omega) * xi.template head<3>());
+    return Sim3(exp(sigma), SO3<S>::exp(omega),
+                scaledRotationIntegral(sigma, omega) * xi.template head<3>());
   }
 
   Tangent log() const {
@@ -191,10 +193,11 @@ class Sim3 {
       return lie_detail::phi1<S, 3>(Matrix3(Omega + sigma * Matrix3::Identity()));
     }
     const S es = exp(sigma);
-    const S a = abs(sigma) < lie_detail::tinyAngle<S>() ? S(1) + sigma / S(2) + sigma * sigma / S(6)
-                                                          : expm1(sigma) / sigma;
+    const S a = abs(sigma) < lie_detail::Numerics<S>::tinyAngle()
+                    ? S(1) + sigma / S(2) + sigma * sigma / S(6)
+                    : expm1(sigma) / sigma;
     S b, c;
-    if (theta < lie_detail::tinyAngle<S>()) {
+    if (theta < lie_detail::Numerics<S>::tinyAngle()) {
       // θ → 0 limits; here |σ| ≥ ½, so their own divisions by σ are harmless.
       const S sigma2 = sigma * sigma;
       b = (es * (sigma - S(1)) + S(1)) / sigma2;
@@ -205,7 +208,8 @@ class Sim3 {
       const S sinT = sin(theta);
       b = (es * sigma * sinT / theta - (es * cosT - S(1))) / denom;
       const S re = ((es * cosT - S(1)) * sigma + es * sinT * theta) / denom;
-      c = (a - re) / theta2;  // cancels for small θ, but then Ω² is O(θ²): absolute error stays O(ε)
+      // Cancels for small θ, but then Ω² is O(θ²): the absolute error of c·Ω² stays O(ε).
+      c = (a - re) / theta2;
     }
     return a * Matrix3::Identity() + b * Omega + c * (Omega * Omega);
   }

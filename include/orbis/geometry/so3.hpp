@@ -43,7 +43,7 @@ class SO3 {
     using std::sqrt;
     const S theta2 = omega.squaredNorm();
     S real, imagFactor;  // q = (cos(θ/2), sin(θ/2)/θ · φ)
-    if (theta2 < lie_detail::smallAngle<S>() * lie_detail::smallAngle<S>()) {
+    if (theta2 < lie_detail::Numerics<S>::smallAngle() * lie_detail::Numerics<S>::smallAngle()) {
       const S theta4 = theta2 * theta2;
       real = S(1) - theta2 / S(8) + theta4 / S(384);
       imagFactor = S(0.5) - theta2 / S(48) + theta4 / S(3840);
@@ -67,7 +67,7 @@ class SO3 {
     const S absW = abs(w);
     const S n2 = q_.vec().squaredNorm();
     S angleOverN;  // θ / |q_vec|, with θ = 2·atan2(|q_vec|, |w|)
-    const S small = lie_detail::smallAngle<S>();
+    const S small = lie_detail::Numerics<S>::smallAngle();
     if (n2 < small * small * w * w) {
       // 2·atan(x)/n with x = n/|w|: series in x² avoids 0/0 at the identity.
       const S x2 = n2 / (w * w);
@@ -90,7 +90,7 @@ class SO3 {
     using std::sqrt;
     Quaternion q = q_ * other.q_;
     const S n2 = q.squaredNorm();
-    if (abs(n2 - S(1)) > lie_detail::quaternionDriftTolerance<S>()) q.coeffs() /= sqrt(n2);
+    if (abs(n2 - S(1)) > lie_detail::Numerics<S>::quaternionDrift()) q.coeffs() /= sqrt(n2);
     return fromUnitQuaternion(q);
   }
   SO3& operator*=(const SO3& other) { return *this = *this * other; }
@@ -115,7 +115,7 @@ class SO3 {
     const S theta2 = omega.squaredNorm();
     const Matrix3 Phi = hat(omega);
     S a, b;
-    if (theta2 < lie_detail::smallAngle<S>() * lie_detail::smallAngle<S>()) {
+    if (theta2 < lie_detail::Numerics<S>::smallAngle() * lie_detail::Numerics<S>::smallAngle()) {
       const S theta4 = theta2 * theta2;
       a = S(0.5) - theta2 / S(24) + theta4 / S(720);
       b = S(1) / S(6) - theta2 / S(120) + theta4 / S(5040);
@@ -136,7 +136,7 @@ class SO3 {
     const S theta2 = omega.squaredNorm();
     const Matrix3 Phi = hat(omega);
     S c;
-    if (theta2 < lie_detail::smallAngle<S>() * lie_detail::smallAngle<S>()) {
+    if (theta2 < lie_detail::Numerics<S>::smallAngle() * lie_detail::Numerics<S>::smallAngle()) {
       c = S(1) / S(12) + theta2 / S(720) + theta2 * theta2 / S(30240);
     } else {
       const S half = sqrt(theta2) / S(2);
