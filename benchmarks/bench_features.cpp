@@ -153,6 +153,22 @@ void BM_OrbisStereo(benchmark::State& state, std::size_t which) {
   state.counters["matched%"] = 100 * matched / total;
 }
 
+// The matching step alone, on features extracted once (what stereo adds to two extractions).
+void BM_OrbisStereoMatchOnly(benchmark::State& state, std::size_t which) {
+  const Dataset& d = datasets()[which];
+  orbis::OrbExtractor left(paramsFor(d)), right(paramsFor(d));
+  std::vector<orbis::Keypoint> kl, kr;
+  std::vector<orbis::OrbDescriptor> dl, dr;
+  left.extract(d.rectifiedLeft[0], kl, dl);
+  right.extract(d.rectifiedRight[0], kr, dr);
+  std::vector<float> uRight, depth;
+  orbis::StereoMatcher matcher;
+  for (auto _ : state) {
+    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), d.bf, d.baseline, uRight, depth);
+    benchmark::DoNotOptimize(uRight.data());
+  }
+}
+
 // The same with cv::ORB on both images and OpenCV's brute-force cross-checked matcher, kept
 // when the rows agree within 2 px and the disparity is positive: a plain OpenCV pipeline.
 void BM_CvOrbStereo(benchmark::State& state, std::size_t which) {
@@ -250,6 +266,7 @@ int main(int argc, char** argv) {
     const std::string& n = datasets()[i].name;
     benchmark::RegisterBenchmark(("Stereo/orbis/" + n).c_str(), BM_OrbisStereo, i)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("Stereo/cvORB/" + n).c_str(), BM_CvOrbStereo, i)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("StereoMatchOnly/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i)->Unit(benchmark::kMillisecond);
   }
   benchmark::Initialize(&argc, argv);
   RatioReporter reporter;
