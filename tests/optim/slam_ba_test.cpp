@@ -109,5 +109,25 @@ TEST(OptimSlamBa, FullBaStopsWhenAborted) {
   EXPECT_TRUE(sameBits(poses[0], scene.initialPoses[0]));  // first keyframe fixed
 }
 
+TEST(OptimSlamBa, LocalBaDumpsItsProblemForReplay) {
+  bench::SlamSceneSpec spec;
+  spec.keyframes = 5;
+  spec.points = 200;
+  spec.stereoFraction = 0.0;
+  spec.seed = 8;
+  const auto scene = bench::makeSlamScene(spec);
+  auto poses = scene.initialPoses;
+  auto points = scene.initialPoints;
+  BundleAdjustmentOptions options;
+  options.dumpBal = std::filesystem::temp_directory_path() / "orbis_local_ba_dump.txt";
+  bundleAdjustment(scene.camera, poses, scene.poseFixed, points, scene.observations, options);
+  const BalProblem bal = readBal(options.dumpBal);
+  std::filesystem::remove(options.dumpBal);
+  EXPECT_EQ(bal.cameras.size(), scene.initialPoses.size());
+  EXPECT_EQ(bal.points.size(), scene.initialPoints.size());
+  EXPECT_EQ(bal.observations.size(), scene.observations.size());
+  EXPECT_NEAR(bal.points[17].x(), scene.initialPoints[17].x(), 1e-12);  // dumped before solving
+}
+
 }  // namespace
 }  // namespace orbis::optim

@@ -7,14 +7,17 @@
 // observation monocular) or a stereo/RGB-D model (monocular observations then use its pinhole).
 // Huber thresholds are the χ² 95% quantiles (5.991 mono, 7.815 stereo). Observations whose χ²
 // exceeds them after the robust pass, or whose point is behind the camera, are reported as
-// outliers, as ORB-SLAM classifies them. Nothing here throws; a solve stops early when
-// abortFlag is raised.
+// outliers, as ORB-SLAM classifies them. Nothing here throws (except writing the optional BAL
+// dump, which throws orbis::Error); a solve stops early when abortFlag is raised.
 #pragma once
 
+#include "orbis/io/bal.hpp"
+#include "orbis/optim/bal.hpp"
 #include "orbis/optim/problem.hpp"
 #include "orbis/optim/reprojection.hpp"
 
 #include <atomic>
+#include <filesystem>
 #include <span>
 #include <vector>
 
@@ -49,6 +52,8 @@ struct BundleAdjustmentOptions {
   double chi2Stereo = kChi2Stereo;
   const std::atomic<bool>* abortFlag = nullptr;
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
+  // When set, the problem is written there in BAL form before solving (for replay with `orbis ba`).
+  std::filesystem::path dumpBal;
 };
 
 struct BundleAdjustmentResult {
@@ -183,6 +188,7 @@ BundleAdjustmentResult bundleAdjustment(const Camera& camera, std::vector<SE3d>&
   for (const auto& o : observations) {
     ids.push_back(slam_detail::addObservation(problem, camera, o, options.chi2Mono, options.chi2Stereo));
   }
+  if (!options.dumpBal.empty()) writeBal(options.dumpBal, exportBal(problem));
   SolverOptions solver;
   solver.maxIterations = options.iterations;
   solver.abortFlag = options.abortFlag;
