@@ -1,6 +1,7 @@
 // Scale pyramid with reflected borders; see include/orbis/features/image_pyramid.hpp.
 #include "orbis/features/image_pyramid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -37,8 +38,9 @@ void ImagePyramid::build(const cv::Mat& gray8u, const ScaleLevels& levels) {
   bordered_.resize(n);
   interior_.resize(n);
   for (std::size_t l = 0; l < n; ++l) {
-    const cv::Size size(static_cast<int>(std::lround(gray8u.cols * levels.invScale[l])),
-                        static_cast<int>(std::lround(gray8u.rows * levels.invScale[l])));
+    // At least one pixel, so tiny inputs give tiny levels rather than an OpenCV assertion.
+    const cv::Size size(std::max(1, static_cast<int>(std::lround(gray8u.cols * levels.invScale[l]))),
+                        std::max(1, static_cast<int>(std::lround(gray8u.rows * levels.invScale[l]))));
     bordered_[l].create(size.height + 2 * kBorder, size.width + 2 * kBorder, CV_8UC1);
     interior_[l] = bordered_[l](cv::Rect(kBorder, kBorder, size.width, size.height));
     if (l == 0) {
