@@ -1,0 +1,132 @@
+// orbis/map/key_frame.hpp — a keyframe: a frame kept in the map (paper §III; ORB-SLAM §III-B).
+//
+// Contract: a KeyFrame owns an immutable copy of its frame's features (keypoints, descriptors,
+// stereo coordinate, grid), its bag-of-words vectors, and — guarded by the owning
+// Map::mutex() — its pose, its map-point associations (one slot per keypoint, null when
+// unmatched), its covisibility edges (weight = shared map points, edges kept from 15) and its
+// place in the spanning tree. Sensor-agnostic: the stereo/RGB-D coordinate uR is < 0 for a
+// monocular keypoint, and the few camera numbers the map needs travel in MapIntrinsics.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "orbis/bow/bow_vector.hpp"
+#include "orbis/features/frame_features.hpp"
+#include "orbis/geometry/se3.hpp"
+#include "orbis/map/map_point.hpp"
+
+namespace orbis {
+
+// What the map needs to know of the camera, whatever the sensor: pinhole intrinsics of the
+// (undistorted, rectified) left image, the stereo/RGB-D baseline times fx (0 for monocular),
+// the close/far depth threshold and the image bounds keypoints may fall in.
+struct MapIntrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  double bf = 0;          // baseline × fx; 0 for a monocular camera
+  double closeDepth = 0;  // depth below which a stereo keypoint is "close" (40 × baseline)
+  double minX = 0, maxX = 0, minY = 0, maxY = 0;
+
+  bool inImage(double u, double v) const { return u >= minX && u < maxX && v >= minY && v < maxY; }
+};
+
+class KeyFrame {
+ public:
+  static constexpr int kCovisibilityThreshold = 15;  // shared points for an edge (ORB-SLAM)
+
+  KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
+           std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
+           bow::BowVector bowVector, bow::FeatureVector featureVector);
+
+  const KeyFrameId id;
+  const std::uint64_t frameIndex;  // index of the frame it was made from
+  const double timestamp;
+  const MapIntrinsics intrinsics;
+
+  // ---- immutable frame data --------------------------------------------------------------
+  const FrameFeatures& features() const { return *features_; }
+  std::size_t size() const { return points_.size(); }
+  const bow::BowVector& bowVector() const { return bow_; }
+  const bow::FeatureVector& featureVector() const { return featureVector_; }
+  // Camera-frame 3-D point of keypoint i from its depth, or nothing for a monocular keypoint.
+  bool unprojectStereo(std::size_t i, Eigen::Vector3d& world) const;
+
+  // ---- pose (camera-from-world) ------------------------------------------------------------
+  const SE3d& Tcw() const { return Tcw_; }
+  SE3d Twc() const { return Tcw_.inverse(); }
+  Eigen::Vector3d cameraCenter() const { return Tcw_.inverse().translation(); }
+  void setPose(const SE3d& Tcw) { Tcw_ = Tcw; }
+
+  // ---- map-point associations ----------------------------------------------------------
+  MapPoint* point(std::size_t i) const { return points_[i]; }
+  const std::vector<MapPoint*>& points() const { return points_; }
+  void setPoint(std::size_t i, MapPoint* p) { points_[i] = p; }
+  void erasePoint(std::size_t i) { points_[i] = nullptr; }
+  void erasePoint(const MapPoint* p);
+  // Map points with at least minObservations observations (ORB-SLAM's TrackedMapPoints).
+  int trackedPoints(int minObservations) const;
+  // Distinct good map points, ordered by id.
+  std::vector<MapPoint*> goodPoints() const;
+
+  // ---- covisibility graph -------------------------------------------------------------
+  // Recomputes this keyframe's edges from its map points, updates the neighbours' edges, and,
+  // the first time, attaches it to the spanning tree under its strongest neighbour.
+  void updateConnections();
+  void addConnection(KeyFrame* kf, int weight);
+  void eraseConnection(KeyFrame* kf);
+  int weight(const KeyFrame* kf) const;
+  // Neighbours by decreasing weight (ties broken by id).
+  const std::vector<KeyFrame*>& covisibles() const { return orderedConnected_; }
+  std::vector<KeyFrame*> bestCovisibles(std::size_t n) const;
+  std::vector<KeyFrame*> covisiblesWithWeightAtLeast(int w) const;
+  std::set<KeyFrame*, ById> connectedSet() const;
+
+  // ---- spanning tree and loop edges ----------------------------------------------------
+  KeyFrame* parent() const { return parent_; }
+  const std::set<KeyFrame*, ById>& children() const { return children_; }
+  void changeParent(KeyFrame* parent);
+  void addChild(KeyFrame* kf) { children_.insert(kf); }
+  void eraseChild(KeyFrame* kf) { children_.erase(kf); }
+  bool hasChild(KeyFrame* kf) const { return children_.count(kf) != 0; }
+  void addLoopEdge(KeyFrame* kf) { loopEdges_.insert(kf); protected_ = true; }
+  const std::set<KeyFrame*, ById>& loopEdges() const { return loopEdges_; }
+
+  // ---- life cycle ------------------------------------------------------------------------
+  bool isBad() const { return bad_; }
+  // Keyframes under loop-closing use are protected from culling.
+  void setProtected(bool p) { protected_ = p || !loopEdges_.empty(); }
+  bool isProtected() const { return protected_; }
+  // Removes the keyframe from the graphs (re-parenting its children by covisibility, as ORB-SLAM
+  // does) and detaches its map points. Returns false when it is protected or the root.
+  bool setBad();
+
+  // Relative pose to the parent recorded when the keyframe went bad, so trajectories can still
+  // express frames referenced to it.
+  const SE3d& poseRelativeToParent() const { return Tcp_; }
+
+  // Indices of keypoints within radius r of (u, v) (undistorted pixels).
+  std::vector<int> featuresInArea(float u, float v, float r) const;
+
+ private:
+  void updateBestCovisibles();
+
+  std::shared_ptr<const FrameFeatures> features_;
+  bow::BowVector bow_;
+  bow::FeatureVector featureVector_;
+  SE3d Tcw_;
+  SE3d Tcp_;
+  std::vector<MapPoint*> points_;
+  std::map<KeyFrame*, int, ById> connectedWeights_;
+  std::vector<KeyFrame*> orderedConnected_;
+  std::vector<int> orderedWeights_;
+  bool firstConnection_ = true;
+  KeyFrame* parent_ = nullptr;
+  std::set<KeyFrame*, ById> children_;
+  std::set<KeyFrame*, ById> loopEdges_;
+  bool protected_ = false;
+  bool bad_ = false;
+};
+
+}  // namespace orbis

@@ -1,0 +1,100 @@
+// orbis/map/map_point.hpp — a 3-D landmark of the sparse map (paper §III; ORB-SLAM §III-C).
+//
+// Contract: a MapPoint stores its world position, the keyframes that observe it (ordered by
+// keyframe id, so every iteration is deterministic), the mean viewing direction, the most
+// distinctive descriptor among its observations and the distance range over which ORB's
+// scale invariance lets it be seen. All mutable members are guarded by the owning
+// Map::mutex(): lock it before calling anything that reads or changes them. Points are never
+// deleted while the map lives; culling marks them bad (and may name a replacement).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "orbis/features/descriptor.hpp"
+
+namespace orbis {
+
+class KeyFrame;
+using KeyFrameId = std::uint64_t;
+using MapPointId = std::uint64_t;
+
+// Orders pointers to keyframes or map points by id, so containers iterate reproducibly.
+struct ById {
+  template <class T>
+  bool operator()(const T* a, const T* b) const { return a->id < b->id; }
+};
+
+class MapPoint {
+ public:
+  MapPoint(MapPointId id, const Eigen::Vector3d& position, KeyFrame* reference, KeyFrameId firstKeyFrame,
+           std::uint64_t firstFrame)
+      : id(id), firstKeyFrame(firstKeyFrame), firstFrame(firstFrame), position_(position), reference_(reference) {}
+
+  const MapPointId id;
+  const KeyFrameId firstKeyFrame;  // keyframe that created it
+  const std::uint64_t firstFrame;  // index of the frame that created it
+
+  const Eigen::Vector3d& position() const { return position_; }
+  void setPosition(const Eigen::Vector3d& p) { position_ = p; }
+  const Eigen::Vector3d& normal() const { return normal_; }
+  const OrbDescriptor& descriptor() const { return descriptor_; }
+  // For points without observations (tracking's temporary visual-odometry points).
+  void setDescriptor(const OrbDescriptor& d) { descriptor_ = d; }
+  KeyFrame* reference() const { return reference_; }
+
+  // keyframe -> index of the keypoint in that keyframe.
+  const std::map<KeyFrame*, std::size_t, ById>& observations() const { return observations_; }
+  // Observation count as ORB-SLAM counts it: a stereo observation counts twice.
+  int observationCount() const { return observationCount_; }
+  bool isObservedBy(const KeyFrame* kf) const;
+  long indexIn(const KeyFrame* kf) const;  // -1 when not observed
+
+  void addObservation(KeyFrame* kf, std::size_t index);
+  // Removes the observation; marks the point bad when two or fewer remain. Returns true if it
+  // turned bad.
+  bool eraseObservation(KeyFrame* kf);
+
+  bool isBad() const { return bad_; }
+  // Detaches the point from every keyframe and marks it bad.
+  void setBad();
+  // Moves all observations of this point to `other` (which survives) and marks this one bad,
+  // recording the replacement so late readers can follow it.
+  void replaceWith(MapPoint* other);
+  MapPoint* replacement() const { return replacedBy_; }
+
+  // Tracking statistics: frames in whose frustum it fell, and frames that matched it.
+  void increaseVisible(int n = 1) { visible_ += n; }
+  void increaseFound(int n = 1) { found_ += n; }
+  int visible() const { return visible_; }
+  int found() const { return found_; }
+  float foundRatio() const { return static_cast<float>(found_) / static_cast<float>(visible_); }
+
+  // Recomputes the representative descriptor: the observation with least median distance to
+  // the others.
+  void computeDistinctiveDescriptor();
+  // Recomputes the mean viewing direction and the scale-invariance distance range from the
+  // reference keyframe's observation.
+  void updateNormalAndDepth();
+  float minDistanceInvariance() const { return 0.8f * minDistance_; }
+  float maxDistanceInvariance() const { return 1.2f * maxDistance_; }
+  // Pyramid level at which the point should appear from `distance` (ORB-SLAM's PredictScale).
+  int predictScale(float distance, int levels, float logScaleFactor) const;
+
+ private:
+  Eigen::Vector3d position_;
+  Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
+  OrbDescriptor descriptor_;
+  float minDistance_ = 0, maxDistance_ = 0;
+  KeyFrame* reference_;
+  std::map<KeyFrame*, std::size_t, ById> observations_;
+  int observationCount_ = 0;
+  int visible_ = 1, found_ = 1;
+  bool bad_ = false;
+  MapPoint* replacedBy_ = nullptr;
+};
+
+}  // namespace orbis
