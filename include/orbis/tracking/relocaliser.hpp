@@ -1,0 +1,92 @@
+// orbis/tracking/relocaliser.hpp — finding a lost camera in the map again (paper §III-F;
+// ORB-SLAM §V-C), and the PnP solver it needs.
+//
+// Contract:
+//  - solveEpnp(world, pixels, K) estimates the camera-from-world pose from n >= 4 world points
+//    and their undistorted pixels by EPnP (Lepetit, Moreno-Noguer, Fua 2009: four control
+//    points, the 12-d null space of M, the three beta approximations refined by Gauss-Newton,
+//    the one with the least reprojection error kept). Returns false for degenerate input.
+//  - solvePnpRansac runs EPnP on random 5-point sets drawn from the caller's generator (so the
+//    result is a function of the input and the seed), counts inliers by the chi-square test
+//    (5.991 × σ² of the keypoint's level), stops when the 0.99-probability bound is met, and
+//    refines the best model on all its inliers.
+//  - Relocaliser::relocalise(frame) (caller holds Map::mutex(), frame BoW computed): candidates
+//    from the keyframe database, BoW matches (ratio 0.75) with each, EPnP-RANSAC on those with
+//    at least 15 matches, motion-only BA, search by projection for more matches and BA again;
+//    accepted at 50 inliers. On success the frame holds the pose and its inlier matches
+//    (outliers cleared) and true is returned; on failure the frame's matches are cleared.
+//    Candidates are tried in the database's deterministic order; the RANSAC generator is seeded
+//    from (seed, frame index), so a run is reproducible whatever happened before.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/StdVector>
+
+#include "orbis/bow/keyframe_database.hpp"
+#include "orbis/map/map.hpp"
+#include "orbis/tracking/frame.hpp"
+
+namespace orbis {
+
+using Vector3dList = std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>>;
+using Vector2dList = std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>>;
+
+bool solveEpnp(const Vector3dList& world, const Vector2dList& pixels, const MapIntrinsics& K, SE3d& Tcw);
+
+struct PnpRansacParams {
+  double probability = 0.99;
+  int minInliers = 10;
+  int maxIterations = 300;
+  double chi2 = 5.991;  // 2-dof, 95%
+};
+
+struct PnpRansacResult {
+  bool found = false;
+  SE3d Tcw;
+  std::vector<char> inlier;  // per correspondence
+  int inliers = 0;
+};
+
+// sigma2[i]: variance of pixel i's measurement (its pyramid level's σ²).
+PnpRansacResult solvePnpRansac(const Vector3dList& world, const Vector2dList& pixels,
+                               const std::vector<float>& sigma2, const MapIntrinsics& K,
+                               const PnpRansacParams& params, std::mt19937_64& rng);
+
+struct RelocaliserOptions {
+  float bowRatio = 0.75f;
+  int minBowMatches = 15;
+  int acceptInliers = 50;
+  std::uint64_t seed = 0;
+  PnpRansacParams ransac;
+};
+
+struct RelocalisationStats {
+  std::size_t attempts = 0, successes = 0;
+  std::size_t lastCandidates = 0;
+  KeyFrameId lastKeyFrame = 0;  // the keyframe the last success matched
+};
+
+class Relocaliser {
+ public:
+  Relocaliser(const Map& map, const bow::KeyframeDatabase& database, RelocaliserOptions options = {})
+      : map_(map), database_(database), options_(options) {}
+
+  bool relocalise(Frame& frame);
+  const RelocalisationStats& stats() const { return stats_; }
+
+ private:
+  // Pose and matches of `frame` from one candidate's BoW matches; false when rejected.
+  bool tryCandidate(Frame& frame, const KeyFrame& kf, const std::vector<MapPoint*>& bowMatches,
+                    std::mt19937_64& rng) const;
+
+  const Map& map_;
+  const bow::KeyframeDatabase& database_;
+  RelocaliserOptions options_;
+  RelocalisationStats stats_;
+};
+
+}  // namespace orbis

@@ -1,0 +1,112 @@
+// orbis/tracking/tracker.hpp — the tracking thread of the paper (§III, Fig. 2a), sensor-agnostic.
+//
+// Contract: track(frame) estimates the frame's camera pose against the map and decides whether
+// it becomes a keyframe. On the first frame with enough depth it bootstraps the map (§III-B).
+// Then: constant-velocity prediction with search by projection, falling back to bag-of-words
+// matching against the reference keyframe; local-map tracking; motion-only BA with outlier
+// rejection; the ORB-SLAM2 keyframe rule including the close-point rule (τt, τc). It holds
+// Map::mutex() while it reads or changes the map. Every tracked frame's pose is kept relative
+// to its reference keyframe, so trajectory() reflects later map corrections (loops, BA).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "orbis/bow/vocabulary.hpp"
+#include "orbis/map/map.hpp"
+#include "orbis/tracking/frame.hpp"
+#include "orbis/util/timing.hpp"
+
+namespace orbis {
+
+using OrbVocabulary = bow::Vocabulary<OrbDescriptor, HammingDistance>;
+class LocalMapper;
+
+enum class TrackingState { NotInitialised, Ok, Lost };
+const char* toString(TrackingState s);
+
+struct TrackerOptions {
+  int closeTrackedThreshold = 100;   // τt: fewer tracked close points than this …
+  int closeCreatableThreshold = 70;  // τc: … and at least this many creatable ones → keyframe
+  int maxFramesBetweenKeyFrames = 30;  // the camera's fps, as ORB-SLAM2
+  int minFramesBetweenKeyFrames = 0;
+  int minBootstrapFeatures = 500;      // keypoints needed to start the map (ORB-SLAM2)
+  int bowLevelsUp = 4;                 // vocabulary level of the FeatureVector grouping
+  bool localisationOnly = false;       // no keyframes, visual-odometry points from depth
+};
+
+struct TrackResult {
+  TrackingState state = TrackingState::NotInitialised;
+  SE3d Tcw;              // valid when state == Ok
+  int inliers = 0;       // matches to map points after motion-only BA
+  bool newKeyFrame = false;
+};
+
+// A tracked frame, stored relative to its reference keyframe.
+struct TrackedFrame {
+  std::uint64_t index;
+  double timestamp;
+  KeyFrame* reference;
+  SE3d Tcr;  // camera-from-reference-keyframe
+};
+
+class Tracker {
+ public:
+  Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMapper* mapper, TrackerOptions options,
+          StageTimer* timer = nullptr);
+
+  TrackResult track(Frame frame);
+
+  TrackingState state() const { return state_; }
+  void setLocalisationOnly(bool on) { options_.localisationOnly = on; }
+  bool localisationOnly() const { return options_.localisationOnly; }
+  // Every tracked frame, by index. Read with the map mutex held (poses move with the map).
+  const std::vector<TrackedFrame>& trackedFrames() const { return tracked_; }
+  // Camera-from-world of a tracked frame through its (possibly since culled) reference keyframe.
+  static SE3d worldPose(const TrackedFrame& f);
+  // Relocalisation hook (loop module): given the frame, returns true and sets its pose/matches
+  // when it found itself in the map again.
+  void setRelocaliser(std::function<bool(Frame&)> relocalise) { relocalise_ = std::move(relocalise); }
+  // A map was loaded: the first frames must relocalise in it rather than start a new map.
+  void startLost() { state_ = TrackingState::Lost; }
+
+ private:
+  void computeBow(Frame& f) const;
+  bool bootstrap(Frame& f);
+  bool trackReferenceKeyFrame();
+  bool trackWithMotionModel();
+  bool trackLocalMap();
+  void updateLastFrame();
+  void replaceRetiredPoints(Frame& f);
+  void updateLocalMap();
+  int searchLocalPoints();
+  bool needNewKeyFrame() const;
+  void createNewKeyFrame();
+  // Runs motion-only BA on current_, then drops outliers; returns matches to map points kept.
+  int optimiseAndDropOutliers();
+
+  Map& map_;
+  const OrbVocabulary& vocabulary_;
+  LocalMapper* mapper_;
+  TrackerOptions options_;
+  StageTimer* timer_;
+  std::function<bool(Frame&)> relocalise_;
+
+  TrackingState state_ = TrackingState::NotInitialised;
+  Frame current_, last_;
+  std::optional<SE3d> velocity_;  // Tcw(current) * Twc(last) of the last tracked pair
+  KeyFrame* reference_ = nullptr;
+  KeyFrame* lastKeyFrame_ = nullptr;
+  std::uint64_t lastKeyFrameFrame_ = 0;
+  std::uint64_t lastRelocalisedFrame_ = 0;
+  int matchesInliers_ = 0;
+  int seenBigChanges_ = 0;
+  std::vector<KeyFrame*> localKeyFrames_;
+  std::vector<MapPoint*> localPoints_;
+  std::vector<MapPoint*> temporaryPoints_;  // visual-odometry points, owned here
+  std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
+  std::vector<TrackedFrame> tracked_;
+};
+
+}  // namespace orbis

@@ -1,0 +1,351 @@
+#include "orbis/tracking/map_matching.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace orbis::matching {
+
+namespace {
+
+constexpr float kViewCosFrontal = 0.998f;
+
+float radiusForViewCos(float viewCos) { return viewCos > kViewCosFrontal ? 2.5f : 4.0f; }
+
+// Clears the rotation outliers from a match list (slots indexed by keypoint).
+template <class Slots>
+int dropRotationOutliers(const RotationHistogram& hist, Slots& slots) {
+  int dropped = 0;
+  for (std::size_t i : hist.outliers()) {
+    if (slots[i] != nullptr) {
+      slots[i] = nullptr;
+      ++dropped;
+    }
+  }
+  return dropped;
+}
+
+}  // namespace
+
+void RotationHistogram::add(float angleDelta, std::size_t index) {
+  float a = angleDelta;
+  if (a < 0) a += 360.f;
+  int bin = static_cast<int>(std::lround(a * (kBins / 360.f)));
+  if (bin == kBins) bin = 0;
+  bins_[std::clamp(bin, 0, kBins - 1)].push_back(index);
+}
+
+std::vector<std::size_t> RotationHistogram::outliers() const {
+  int best[3] = {-1, -1, -1};
+  std::size_t count[3] = {0, 0, 0};
+  for (int b = 0; b < kBins; ++b) {
+    const std::size_t n = bins_[b].size();
+    if (n > count[0]) {
+      best[2] = best[1]; count[2] = count[1];
+      best[1] = best[0]; count[1] = count[0];
+      best[0] = b; count[0] = n;
+    } else if (n > count[1]) {
+      best[2] = best[1]; count[2] = count[1];
+      best[1] = b; count[1] = n;
+    } else if (n > count[2]) {
+      best[2] = b; count[2] = n;
+    }
+  }
+  // Secondary bins count only when they hold a real share of the dominant one (ORB-SLAM: 10%).
+  if (count[1] < 0.1 * static_cast<double>(count[0])) { best[1] = -1; best[2] = -1; }
+  else if (count[2] < 0.1 * static_cast<double>(count[0])) { best[2] = -1; }
+  std::vector<std::size_t> out;
+  for (int b = 0; b < kBins; ++b) {
+    if (b == best[0] || b == best[1] || b == best[2]) continue;
+    out.insert(out.end(), bins_[b].begin(), bins_[b].end());
+  }
+  return out;
+}
+
+bool projectIntoFrame(const MapPoint& point, const SE3d& Tcw, const MapIntrinsics& K, const ScaleLevels& levels,
+                      Projection& out) {
+  const Eigen::Vector3d pw = point.position();
+  const Eigen::Vector3d pc = Tcw * pw;
+  if (pc.z() <= 0) return false;
+  const double invZ = 1.0 / pc.z();
+  const double u = K.fx * pc.x() * invZ + K.cx;
+  const double v = K.fy * pc.y() * invZ + K.cy;
+  if (!K.inImage(u, v)) return false;
+  const Eigen::Vector3d po = pw - Tcw.inverse().translation();
+  const float dist = static_cast<float>(po.norm());
+  if (dist < point.minDistanceInvariance() || dist > point.maxDistanceInvariance()) return false;
+  const Eigen::Vector3d& n = point.normal();
+  const float viewCos = n.norm() > 0 ? static_cast<float>(po.dot(n) / (dist * n.norm())) : 1.f;
+  if (viewCos < 0.5f) return false;
+  out.u = static_cast<float>(u);
+  out.v = static_cast<float>(v);
+  out.uRight = K.bf > 0 ? static_cast<float>(u - K.bf * invZ) : -1.f;
+  out.level = point.predictScale(dist, levels.levels(), levels.logFactor());
+  out.viewCos = viewCos;
+  return true;
+}
+
+int matchFromLastFrame(Frame& current, const Frame& last, float radius, bool checkOrientation) {
+  const FrameFeatures& cf = *current.features;
+  const ScaleLevels& levels = cf.scales;
+  RotationHistogram hist;
+  const SE3d& Tcw = current.Tcw;
+  const Eigen::Vector3d tlc = last.Tcw * current.cameraCenter();  // current centre in last's frame
+  const bool stereo = current.intrinsics.bf > 0;
+  const bool forward = stereo && tlc.z() > current.intrinsics.bf / current.intrinsics.fx;
+  const bool backward = stereo && -tlc.z() > current.intrinsics.bf / current.intrinsics.fx;
+  int matches = 0;
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    MapPoint* p = last.points[i];
+    if (!p || last.outlier[i] || p->isBad()) continue;
+    const Eigen::Vector3d pc = Tcw * p->position();
+    if (pc.z() <= 0) continue;
+    const double invZ = 1.0 / pc.z();
+    const float u = static_cast<float>(current.intrinsics.fx * pc.x() * invZ + current.intrinsics.cx);
+    const float v = static_cast<float>(current.intrinsics.fy * pc.y() * invZ + current.intrinsics.cy);
+    if (!current.intrinsics.inImage(u, v)) continue;
+    const int lastOctave = last.features->keypointsUn[i].octave;
+    const float r = radius * levels.scale[static_cast<std::size_t>(lastOctave)];
+    int minLevel = lastOctave - 1, maxLevel = lastOctave + 1;
+    if (forward) { minLevel = lastOctave; maxLevel = levels.levels() - 1; }
+    else if (backward) { minLevel = 0; maxLevel = lastOctave; }
+    const auto candidates = cf.grid.featuresInArea(u, v, r, std::max(0, minLevel), maxLevel);
+    const float uRightPred = static_cast<float>(u - current.intrinsics.bf * invZ);
+    int bestDist = 256;
+    std::size_t best = 0;
+    for (std::size_t j : candidates) {
+      if (MapPoint* q = current.points[j]; q && q->observationCount() > 0) continue;
+      if (stereo && cf.uRight[j] >= 0 && std::abs(uRightPred - cf.uRight[j]) > r) continue;
+      const int d = hammingDistance(p->descriptor(), cf.descriptors[j]);
+      if (d < bestDist) { bestDist = d; best = j; }
+    }
+    if (bestDist <= kThHigh) {
+      current.points[best] = p;
+      current.outlier[best] = 0;
+      ++matches;
+      if (checkOrientation) hist.add(last.features->keypointsUn[i].angle - cf.keypointsUn[best].angle, best);
+    }
+  }
+  if (checkOrientation) matches -= dropRotationOutliers(hist, current.points);
+  return matches;
+}
+
+int matchLocalPoints(Frame& frame, const std::vector<MapPoint*>& points, const std::vector<Projection>& projections,
+                     float radiusFactor, float ratio) {
+  const FrameFeatures& f = *frame.features;
+  int matches = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    MapPoint* p = points[k];
+    if (!p || p->isBad()) continue;
+    const Projection& pr = projections[k];
+    const float r = radiusFactor * radiusForViewCos(pr.viewCos) * f.scales.scale[static_cast<std::size_t>(pr.level)];
+    const auto candidates = f.grid.featuresInArea(pr.u, pr.v, r, pr.level - 1, pr.level);
+    int bestDist = 256, secondDist = 256, bestLevel = -1, secondLevel = -1;
+    std::size_t best = 0;
+    for (std::size_t j : candidates) {
+      if (MapPoint* q = frame.points[j]; q && q->observationCount() > 0) continue;
+      if (pr.uRight >= 0 && f.uRight[j] >= 0 && std::abs(pr.uRight - f.uRight[j]) > r) continue;
+      const int d = hammingDistance(p->descriptor(), f.descriptors[j]);
+      if (d < bestDist) {
+        secondDist = bestDist; secondLevel = bestLevel;
+        bestDist = d; bestLevel = f.keypointsUn[j].octave; best = j;
+      } else if (d < secondDist) {
+        secondDist = d; secondLevel = f.keypointsUn[j].octave;
+      }
+    }
+    if (bestDist > kThHigh) continue;
+    if (bestLevel == secondLevel && bestDist > ratio * secondDist) continue;
+    frame.points[best] = p;
+    frame.outlier[best] = 0;
+    ++matches;
+  }
+  return matches;
+}
+
+int matchByBow(const KeyFrame& kf, const Frame& frame, std::vector<MapPoint*>& out, float ratio, bool checkOrientation) {
+  const FrameFeatures& kff = kf.features();
+  const FrameFeatures& ff = *frame.features;
+  out.assign(frame.size(), nullptr);
+  RotationHistogram hist;
+  int matches = 0;
+  const auto& a = kf.featureVector();
+  const auto& b = frame.featureVector;
+  std::size_t ia = 0, ib = 0;
+  while (ia < a.size() && ib < b.size()) {
+    const auto nodeA = a.node(ia), nodeB = b.node(ib);
+    if (nodeA < nodeB) { ++ia; continue; }
+    if (nodeB < nodeA) { ++ib; continue; }
+    for (std::uint32_t i : a.featuresOf(ia)) {
+      MapPoint* p = kf.point(i);
+      if (!p || p->isBad()) continue;
+      int bestDist = 256, secondDist = 256;
+      std::uint32_t best = 0;
+      for (std::uint32_t j : b.featuresOf(ib)) {
+        if (out[j]) continue;
+        const int d = hammingDistance(kff.descriptors[i], ff.descriptors[j]);
+        if (d < bestDist) { secondDist = bestDist; bestDist = d; best = j; }
+        else if (d < secondDist) secondDist = d;
+      }
+      if (bestDist <= kThLow && bestDist < ratio * secondDist) {
+        out[best] = p;
+        ++matches;
+        if (checkOrientation) hist.add(kff.keypointsUn[i].angle - ff.keypointsUn[best].angle, best);
+      }
+    }
+    ++ia;
+    ++ib;
+  }
+  if (checkOrientation) matches -= dropRotationOutliers(hist, out);
+  return matches;
+}
+
+int matchFromKeyFrame(Frame& frame, const KeyFrame& kf, const std::set<MapPoint*, ById>& alreadyFound, float radius,
+                      int maxDistance) {
+  const FrameFeatures& f = *frame.features;
+  const Eigen::Vector3d center = frame.cameraCenter();
+  RotationHistogram hist;
+  int matches = 0;
+  for (std::size_t i = 0; i < kf.size(); ++i) {
+    MapPoint* p = kf.point(i);
+    if (!p || p->isBad() || alreadyFound.count(p)) continue;
+    const Eigen::Vector3d pc = frame.Tcw * p->position();
+    if (pc.z() <= 0) continue;
+    const float u = static_cast<float>(frame.intrinsics.fx * pc.x() / pc.z() + frame.intrinsics.cx);
+    const float v = static_cast<float>(frame.intrinsics.fy * pc.y() / pc.z() + frame.intrinsics.cy);
+    if (!frame.intrinsics.inImage(u, v)) continue;
+    const float dist = static_cast<float>((p->position() - center).norm());
+    if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;
+    const int level = p->predictScale(dist, f.scales.levels(), f.scales.logFactor());
+    const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
+    int bestDist = 256;
+    std::size_t best = 0;
+    for (std::size_t j : f.grid.featuresInArea(u, v, r, level - 1, level + 1)) {
+      if (frame.points[j]) continue;
+      const int d = hammingDistance(p->descriptor(), f.descriptors[j]);
+      if (d < bestDist) { bestDist = d; best = j; }
+    }
+    if (bestDist <= maxDistance) {
+      frame.points[best] = p;
+      frame.outlier[best] = 0;
+      ++matches;
+      hist.add(kf.features().keypointsUn[i].angle - f.keypointsUn[best].angle, best);
+    }
+  }
+  matches -= dropRotationOutliers(hist, frame.points);
+  return matches;
+}
+
+std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const KeyFrame& kf1, const KeyFrame& kf2,
+                                                                      const Eigen::Matrix3d& F12, bool onlyStereo) {
+  const FrameFeatures& f1 = kf1.features();
+  const FrameFeatures& f2 = kf2.features();
+  // Epipole of kf1's centre in kf2: keypoints too close to it have unreliable depth.
+  const Eigen::Vector3d c1in2 = kf2.Tcw() * kf1.cameraCenter();
+  const double ex = kf2.intrinsics.fx * c1in2.x() / c1in2.z() + kf2.intrinsics.cx;
+  const double ey = kf2.intrinsics.fy * c1in2.y() / c1in2.z() + kf2.intrinsics.cy;
+  std::vector<long> matched2(kf2.size(), -1);
+  std::vector<long> matched1(kf1.size(), -1);
+  RotationHistogram hist;
+  const auto& a = kf1.featureVector();
+  const auto& b = kf2.featureVector();
+  std::size_t ia = 0, ib = 0;
+  while (ia < a.size() && ib < b.size()) {
+    const auto nodeA = a.node(ia), nodeB = b.node(ib);
+    if (nodeA < nodeB) { ++ia; continue; }
+    if (nodeB < nodeA) { ++ib; continue; }
+    for (std::uint32_t i : a.featuresOf(ia)) {
+      if (kf1.point(i)) continue;
+      const bool stereo1 = f1.uRight[i] >= 0;
+      if (onlyStereo && !stereo1) continue;
+      const Keypoint& k1 = f1.keypointsUn[i];
+      const Eigen::Vector3d line = F12.transpose() * Eigen::Vector3d(k1.u, k1.v, 1.0);
+      int bestDist = kThLow;
+      long best = -1;
+      for (std::uint32_t j : b.featuresOf(ib)) {
+        if (kf2.point(j) || matched2[j] >= 0) continue;
+        const bool stereo2 = f2.uRight[j] >= 0;
+        if (onlyStereo && !stereo2) continue;
+        const int d = hammingDistance(f1.descriptors[i], f2.descriptors[j]);
+        if (d > kThLow || d > bestDist) continue;
+        const Keypoint& k2 = f2.keypointsUn[j];
+        if (!stereo1 && !stereo2) {
+          const double dx = ex - k2.u, dy = ey - k2.v;
+          if (dx * dx + dy * dy < 100 * f2.scales.scale[static_cast<std::size_t>(k2.octave)]) continue;
+        }
+        const double num = line.x() * k2.u + line.y() * k2.v + line.z();
+        const double den = line.x() * line.x() + line.y() * line.y();
+        if (den == 0) continue;
+        if (num * num / den < 3.84 * f2.scales.sigma2[static_cast<std::size_t>(k2.octave)]) {
+          best = j;
+          bestDist = d;
+        }
+      }
+      if (best >= 0) {
+        matched2[static_cast<std::size_t>(best)] = i;
+        matched1[i] = best;
+        hist.add(k1.angle - f2.keypointsUn[static_cast<std::size_t>(best)].angle, i);
+      }
+    }
+    ++ia;
+    ++ib;
+  }
+  for (std::size_t i : hist.outliers()) matched1[i] = -1;
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  for (std::size_t i = 0; i < matched1.size(); ++i)
+    if (matched1[i] >= 0) out.emplace_back(i, static_cast<std::size_t>(matched1[i]));
+  return out;
+}
+
+int fuse(KeyFrame& kf, const std::vector<MapPoint*>& points, float radius) {
+  const FrameFeatures& f = kf.features();
+  const MapIntrinsics& K = kf.intrinsics;
+  const SE3d Tcw = kf.Tcw();
+  const Eigen::Vector3d center = kf.cameraCenter();
+  int fused = 0;
+  for (MapPoint* p : points) {
+    if (!p || p->isBad() || p->isObservedBy(&kf)) continue;
+    const Eigen::Vector3d pc = Tcw * p->position();
+    if (pc.z() <= 0) continue;
+    const double invZ = 1.0 / pc.z();
+    const double u = K.fx * pc.x() * invZ + K.cx;
+    const double v = K.fy * pc.y() * invZ + K.cy;
+    if (!K.inImage(u, v)) continue;
+    const double ur = u - K.bf * invZ;
+    const Eigen::Vector3d po = p->position() - center;
+    const float dist = static_cast<float>(po.norm());
+    if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;
+    if (p->normal().norm() > 0 && po.dot(p->normal()) < 0.5 * dist * p->normal().norm()) continue;
+    const int level = p->predictScale(dist, f.scales.levels(), f.scales.logFactor());
+    const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
+    int bestDist = 256;
+    long best = -1;
+    for (std::size_t j : f.grid.featuresInArea(static_cast<float>(u), static_cast<float>(v), r)) {
+      const Keypoint& k = f.keypointsUn[j];
+      if (k.octave < level - 1 || k.octave > level) continue;
+      const double ex = u - k.u, ey = v - k.v;
+      const double inv2 = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
+      if (f.uRight[j] >= 0) {
+        const double er = ur - f.uRight[j];
+        if ((ex * ex + ey * ey + er * er) * inv2 > 7.8) continue;
+      } else if ((ex * ex + ey * ey) * inv2 > 5.99) {
+        continue;
+      }
+      const int d = hammingDistance(p->descriptor(), f.descriptors[j]);
+      if (d < bestDist) { bestDist = d; best = static_cast<long>(j); }
+    }
+    if (best < 0 || bestDist > kThLow) continue;
+    const auto j = static_cast<std::size_t>(best);
+    if (MapPoint* existing = kf.point(j); existing && !existing->isBad()) {
+      // Keep the better-observed point; the other is merged into it.
+      if (existing->observationCount() > p->observationCount()) p->replaceWith(existing);
+      else existing->replaceWith(p);
+    } else {
+      p->addObservation(&kf, j);
+      kf.setPoint(j, p);
+    }
+    ++fused;
+  }
+  return fused;
+}
+
+}  // namespace orbis::matching

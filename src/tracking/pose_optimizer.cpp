@@ -1,0 +1,69 @@
+#include "orbis/tracking/pose_optimizer.hpp"
+
+#include <limits>
+#include <vector>
+
+#include "orbis/optim/slam_residuals.hpp"
+
+namespace orbis {
+
+int optimizePose(Frame& frame) {
+  using namespace optim;
+  const MapIntrinsics& K = frame.intrinsics;
+  const ObservationCameras cameras(K.fx, K.fy, K.cx, K.cy, K.bf);
+  const FrameFeatures& f = *frame.features;
+  SlamProblem problem;
+  const int pose = problem.addPose(frame.Tcw);
+  struct Edge {
+    std::size_t keypoint;
+    ResidualId id;
+    bool stereo;
+  };
+  std::vector<Edge> edges;
+  edges.reserve(frame.size());
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    MapPoint* p = frame.points[i];
+    if (!p) continue;
+    frame.outlier[i] = 0;
+    const int point = problem.addPoint(p->position(), /*fixed=*/true);
+    const Keypoint& k = f.keypointsUn[i];
+    const double information = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
+    if (f.uRight[i] < 0) {
+      const MonoReprojection r{{k.u, k.v}, &cameras.mono};
+      edges.push_back({i, problem.add(r, pose, point, information, kChi2Mono), false});
+    } else {
+      const StereoReprojection r{{k.u, k.v, f.uRight[i]}, &cameras.stereo};
+      edges.push_back({i, problem.add(r, pose, point, information, kChi2Stereo), true});
+    }
+  }
+  if (edges.size() < 3) return 0;
+
+  // ORB-SLAM's schedule: four rounds of 10 iterations from the initial pose, reclassifying every
+  // observation by its χ² after each; the last two rounds without the robust kernel.
+  SolverOptions options;
+  options.maxIterations = 10;
+  options.linearSolver = LinearSolverKind::DenseCholesky;
+  int bad = 0;
+  for (int round = 0; round < 4; ++round) {
+    problem.setPose(pose, frame.Tcw);
+    problem.solve(options);
+    bad = 0;
+    for (const Edge& e : edges) {
+      const double chi2 = problem.chi2(e.id);
+      const bool isOutlier = chi2 > (e.stereo ? kChi2Stereo : kChi2Mono);
+      frame.outlier[e.keypoint] = isOutlier ? 1 : 0;
+      problem.setActive(e.id, !isOutlier);
+      bad += isOutlier ? 1 : 0;
+      if (round == 2) {
+        if (e.stereo) problem.records<1>()[static_cast<std::size_t>(e.id.index)].delta2 = std::numeric_limits<double>::infinity();
+        else problem.records<0>()[static_cast<std::size_t>(e.id.index)].delta2 = std::numeric_limits<double>::infinity();
+      }
+    }
+    if (static_cast<int>(edges.size()) - bad < 10) break;
+  }
+  frame.Tcw = problem.pose(pose);
+  frame.hasPose = true;
+  return static_cast<int>(edges.size()) - bad;
+}
+
+}  // namespace orbis

@@ -1,0 +1,391 @@
+#include "orbis/tracking/tracker.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <map>
+
+#include "orbis/mapping/local_mapper.hpp"
+#include "orbis/tracking/map_matching.hpp"
+#include "orbis/tracking/pose_optimizer.hpp"
+
+namespace orbis {
+
+const char* toString(TrackingState s) {
+  switch (s) {
+    case TrackingState::NotInitialised: return "not-initialised";
+    case TrackingState::Ok: return "ok";
+    case TrackingState::Lost: return "lost";
+  }
+  return "?";
+}
+
+Tracker::Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMapper* mapper, TrackerOptions options,
+                 StageTimer* timer)
+    : map_(map), vocabulary_(vocabulary), mapper_(mapper), options_(options), timer_(timer) {}
+
+SE3d Tracker::worldPose(const TrackedFrame& f) {
+  // A culled reference keyframe hangs from its parent by the relative pose it had when culled.
+  const KeyFrame* kf = f.reference;
+  SE3d Trw;  // reference-from-world, accumulated up the spanning tree
+  SE3d chain;
+  while (kf->isBad() && kf->parent()) {
+    chain = chain * kf->poseRelativeToParent();
+    kf = kf->parent();
+  }
+  Trw = chain * kf->Tcw();
+  return f.Tcr * Trw;
+}
+
+void Tracker::computeBow(Frame& f) const {
+  if (f.hasBow) return;
+  vocabulary_.transform(std::span<const OrbDescriptor>(f.features->descriptors), f.bow, f.featureVector,
+                        options_.bowLevelsUp);
+  f.hasBow = true;
+}
+
+TrackResult Tracker::track(Frame frame) {
+  std::lock_guard lock(map_.mutex());
+  current_ = std::move(frame);
+  current_.resetMatches();
+  TrackResult result;
+
+  if (state_ == TrackingState::NotInitialised) {
+    ScopedStage stage(timer_, "tracking: bootstrap");
+    if (bootstrap(current_)) {
+      state_ = TrackingState::Ok;
+      result.newKeyFrame = true;
+    }
+  } else {
+    bool ok = false;
+    {
+      ScopedStage stage(timer_, "tracking: pose prediction");
+      if (state_ == TrackingState::Ok) {
+        replaceRetiredPoints(last_);
+        // After a loop closure the velocity is still valid but the last pose moved: ORB-SLAM
+        // re-reads it from its reference keyframe (updateLastFrame).
+        const bool recentlyRelocalised = current_.index < lastRelocalisedFrame_ + 2;
+        if (!velocity_ || recentlyRelocalised) {
+          ok = trackReferenceKeyFrame();
+        } else {
+          ok = trackWithMotionModel();
+          if (!ok) ok = trackReferenceKeyFrame();
+        }
+      } else if (relocalise_) {
+        computeBow(current_);
+        ok = relocalise_(current_);
+        if (ok) lastRelocalisedFrame_ = current_.index;
+      }
+    }
+    if (ok) {
+      ScopedStage stage(timer_, "tracking: local map");
+      ok = trackLocalMap();
+    }
+    state_ = ok ? TrackingState::Ok : TrackingState::Lost;
+    if (ok) {
+      velocity_ = current_.Tcw * last_.Tcw.inverse();
+      // Visual-odometry matches do not survive the frame.
+      for (std::size_t i = 0; i < current_.size(); ++i)
+        if (current_.points[i] && current_.points[i]->observationCount() < 1) {
+          current_.points[i] = nullptr;
+          current_.outlier[i] = 0;
+        }
+      temporaryPoints_.clear();
+      temporaryStorage_.clear();
+      ScopedStage stage(timer_, "tracking: keyframe decision");
+      if (needNewKeyFrame()) {
+        createNewKeyFrame();
+        result.newKeyFrame = true;
+      }
+      for (std::size_t i = 0; i < current_.size(); ++i)
+        if (current_.points[i] && current_.outlier[i]) {
+          current_.points[i] = nullptr;
+          current_.outlier[i] = 0;
+        }
+    } else {
+      velocity_.reset();
+    }
+  }
+
+  result.state = state_;
+  if (state_ == TrackingState::Ok) {
+    result.Tcw = current_.Tcw;
+    result.inliers = matchesInliers_;
+    tracked_.push_back({current_.index, current_.timestamp, reference_, current_.Tcw * reference_->Tcw().inverse()});
+  }
+  if (state_ != TrackingState::NotInitialised) last_ = current_;
+  return result;
+}
+
+bool Tracker::bootstrap(Frame& f) {
+  // ORB-SLAM2 starts on any frame with more than 500 keypoints; the map gets those with depth.
+  if (static_cast<int>(f.size()) <= options_.minBootstrapFeatures) return false;
+  f.Tcw = SE3d();
+  f.hasPose = true;
+  computeBow(f);
+  KeyFrame* kf = map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics, f.bow, f.featureVector);
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    Eigen::Vector3d pw;
+    if (!f.unprojectStereo(i, pw)) continue;
+    MapPoint* p = map_.createMapPoint(pw, kf, f.index);
+    p->addObservation(kf, i);
+    kf->setPoint(i, p);
+    p->computeDistinctiveDescriptor();
+    p->updateNormalAndDepth();
+    f.points[i] = p;
+  }
+  reference_ = lastKeyFrame_ = kf;
+  lastKeyFrameFrame_ = f.index;
+  localKeyFrames_ = {kf};
+  localPoints_ = map_.mapPoints();
+  map_.setReferencePoints(localPoints_);
+  if (mapper_) mapper_->insertKeyFrame(kf);
+  matchesInliers_ = static_cast<int>(localPoints_.size());
+  return true;
+}
+
+void Tracker::replaceRetiredPoints(Frame& f) {
+  for (auto& p : f.points)
+    if (p && p->replacement()) {
+      MapPoint* r = p->replacement();
+      while (r->replacement()) r = r->replacement();
+      p = r;
+    }
+}
+
+int Tracker::optimiseAndDropOutliers() {
+  optimizePose(current_);
+  int matchesMap = 0;
+  for (std::size_t i = 0; i < current_.size(); ++i) {
+    MapPoint* p = current_.points[i];
+    if (!p) continue;
+    if (current_.outlier[i]) {
+      current_.points[i] = nullptr;
+      current_.outlier[i] = 0;
+    } else if (p->observationCount() > 0) {
+      ++matchesMap;
+    }
+  }
+  return matchesMap;
+}
+
+bool Tracker::trackReferenceKeyFrame() {
+  computeBow(current_);
+  std::vector<MapPoint*> matches;
+  const int n = matching::matchByBow(*reference_, current_, matches, 0.7f, true);
+  if (n < 15) return false;
+  current_.points = std::move(matches);
+  current_.outlier.assign(current_.size(), 0);
+  current_.Tcw = last_.Tcw;
+  return optimiseAndDropOutliers() >= 10;
+}
+
+void Tracker::updateLastFrame() {
+  // The last frame's pose, re-read through its reference keyframe (which BA may have moved).
+  if (!tracked_.empty()) last_.Tcw = worldPose(tracked_.back());
+  if (!options_.localisationOnly || last_.index == lastKeyFrameFrame_ || last_.intrinsics.bf <= 0) return;
+  // Localisation mode: temporary points from the last frame's depth, so that tracking survives
+  // where the map has no points (paper §III-F).
+  std::vector<std::pair<float, std::size_t>> byDepth;
+  for (std::size_t i = 0; i < last_.size(); ++i)
+    if (last_.features->depth[i] > 0) byDepth.emplace_back(last_.features->depth[i], i);
+  std::sort(byDepth.begin(), byDepth.end());
+  int created = 0;
+  for (const auto& [z, i] : byDepth) {
+    MapPoint* existing = last_.points[i];
+    if (!existing || existing->observationCount() < 1) {
+      Eigen::Vector3d pw;
+      last_.unprojectStereo(i, pw);
+      const MapPointId tempId = std::numeric_limits<MapPointId>::max() - temporaryStorage_.size();
+      temporaryStorage_.push_back(std::make_unique<MapPoint>(tempId, pw, nullptr, 0, last_.index));
+      MapPoint* p = temporaryStorage_.back().get();
+      p->setDescriptor(last_.features->descriptors[i]);
+      last_.points[i] = p;
+      last_.outlier[i] = 0;
+      temporaryPoints_.push_back(p);
+    }
+    ++created;
+    if (z > last_.intrinsics.closeDepth && created > 100) break;
+  }
+}
+
+bool Tracker::trackWithMotionModel() {
+  updateLastFrame();
+  current_.Tcw = *velocity_ * last_.Tcw;
+  current_.resetMatches();
+  const bool stereo = current_.intrinsics.bf > 0;
+  const float radius = stereo ? 7.f : 15.f;
+  int n = matching::matchFromLastFrame(current_, last_, radius, !stereo);
+  if (n < 20) {
+    current_.resetMatches();
+    n = matching::matchFromLastFrame(current_, last_, 2 * radius, !stereo);
+  }
+  if (n < 20) return false;
+  const int matchesMap = optimiseAndDropOutliers();
+  if (options_.localisationOnly) return current_.inliers() >= 10 || matchesMap >= 10;
+  return matchesMap >= 10;
+}
+
+void Tracker::updateLocalMap() {
+  // Keyframes observing the frame's points, weighted by how many they observe.
+  std::map<KeyFrame*, int, ById> counter;
+  for (std::size_t i = 0; i < current_.size(); ++i) {
+    MapPoint* p = current_.points[i];
+    if (!p) continue;
+    if (p->isBad()) {
+      current_.points[i] = nullptr;
+      continue;
+    }
+    for (const auto& [kf, idx] : p->observations()) ++counter[kf];
+  }
+  if (counter.empty()) return;
+  std::vector<KeyFrame*> local;
+  std::set<KeyFrame*, ById> seen;
+  KeyFrame* best = nullptr;
+  int bestCount = 0;
+  for (const auto& [kf, n] : counter) {
+    if (kf->isBad()) continue;
+    if (n > bestCount) { bestCount = n; best = kf; }
+    local.push_back(kf);
+    seen.insert(kf);
+  }
+  // Neighbours: best covisibles, children and parent of the first-level keyframes (ORB-SLAM's
+  // UpdateLocalKeyFrames), up to 80 in all.
+  const std::size_t firstLevel = local.size();
+  for (std::size_t k = 0; k < firstLevel && local.size() < 80; ++k) {
+    KeyFrame* kf = local[k];
+    for (KeyFrame* n : kf->bestCovisibles(10))
+      if (!n->isBad() && seen.insert(n).second) { local.push_back(n); break; }
+    for (KeyFrame* c : kf->children())
+      if (!c->isBad() && seen.insert(c).second) { local.push_back(c); break; }
+    if (KeyFrame* parent = kf->parent(); parent && seen.insert(parent).second) local.push_back(parent);
+  }
+  localKeyFrames_ = std::move(local);
+  if (best) reference_ = best;
+  // Their points, each once, in keyframe order.
+  std::set<MapPoint*, ById> pointsSeen;
+  localPoints_.clear();
+  for (KeyFrame* kf : localKeyFrames_)
+    for (MapPoint* p : kf->points())
+      if (p && !p->isBad() && pointsSeen.insert(p).second) localPoints_.push_back(p);
+  map_.setReferencePoints(localPoints_);
+}
+
+int Tracker::searchLocalPoints() {
+  std::set<MapPoint*, ById> alreadyMatched;
+  for (std::size_t i = 0; i < current_.size(); ++i) {
+    MapPoint* p = current_.points[i];
+    if (!p) continue;
+    if (p->isBad()) {
+      current_.points[i] = nullptr;
+      continue;
+    }
+    p->increaseVisible();
+    alreadyMatched.insert(p);
+  }
+  std::vector<MapPoint*> candidates;
+  std::vector<matching::Projection> projections;
+  for (MapPoint* p : localPoints_) {
+    if (alreadyMatched.count(p) || p->isBad()) continue;
+    matching::Projection pr;
+    if (!matching::projectIntoFrame(*p, current_.Tcw, current_.intrinsics, current_.features->scales, pr)) continue;
+    p->increaseVisible();
+    candidates.push_back(p);
+    projections.push_back(pr);
+  }
+  if (candidates.empty()) return 0;
+  float radius = current_.isRgbd ? 3.f : 1.f;
+  if (current_.index < lastRelocalisedFrame_ + 2) radius = 5.f;
+  return matching::matchLocalPoints(current_, candidates, projections, radius);
+}
+
+bool Tracker::trackLocalMap() {
+  updateLocalMap();
+  searchLocalPoints();
+  optimizePose(current_);
+  matchesInliers_ = 0;
+  for (std::size_t i = 0; i < current_.size(); ++i) {
+    MapPoint* p = current_.points[i];
+    if (!p) continue;
+    if (!current_.outlier[i]) {
+      p->increaseFound();
+      if (options_.localisationOnly || p->observationCount() > 0) ++matchesInliers_;
+    } else if (current_.isStereo(i)) {
+      current_.points[i] = nullptr;
+      current_.outlier[i] = 0;
+    }
+  }
+  const bool recentlyRelocalised = current_.index < lastRelocalisedFrame_ + static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
+  if (recentlyRelocalised && lastRelocalisedFrame_ > 0 && matchesInliers_ < 50) return false;
+  return matchesInliers_ >= 30;
+}
+
+bool Tracker::needNewKeyFrame() const {
+  if (options_.localisationOnly) return false;
+  if (mapper_ && mapper_->isStoppedOrStopping()) return false;
+  const std::size_t keyFrames = map_.keyFrameCount();
+  const auto maxFrames = static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
+  if (lastRelocalisedFrame_ > 0 && current_.index < lastRelocalisedFrame_ + maxFrames && keyFrames > maxFrames)
+    return false;
+  const int minObservations = keyFrames <= 2 ? 2 : 3;
+  const int referenceMatches = reference_->trackedPoints(minObservations);
+  const bool mapperIdle = mapper_ ? mapper_->acceptsKeyFrames() : true;
+
+  int trackedClose = 0, untrackedClose = 0;
+  for (std::size_t i = 0; i < current_.size(); ++i) {
+    if (!current_.isClose(i)) continue;
+    if (current_.points[i] && !current_.outlier[i]) ++trackedClose;
+    else ++untrackedClose;
+  }
+  const bool needClose = trackedClose < options_.closeTrackedThreshold && untrackedClose > options_.closeCreatableThreshold;
+  const float refRatio = keyFrames < 2 ? 0.4f : 0.75f;
+  const bool c1a = current_.index >= lastKeyFrameFrame_ + maxFrames;
+  const bool c1b = current_.index >= lastKeyFrameFrame_ + static_cast<std::uint64_t>(options_.minFramesBetweenKeyFrames) && mapperIdle;
+  const bool c1c = matchesInliers_ < referenceMatches * 0.25f || needClose;
+  const bool c2 = (matchesInliers_ < referenceMatches * refRatio || needClose) && matchesInliers_ > 15;
+  if (!((c1a || c1b || c1c) && c2)) return false;
+  if (mapperIdle) return true;
+  if (mapper_) mapper_->interruptBundleAdjustment();
+  return mapper_ && mapper_->queuedKeyFrames() < 3;
+}
+
+void Tracker::createNewKeyFrame() {
+  if (mapper_ && !mapper_->setNotStop(true)) return;
+  computeBow(current_);
+  KeyFrame* kf = map_.createKeyFrame(current_.index, current_.timestamp, current_.Tcw, current_.features,
+                                     current_.intrinsics, current_.bow, current_.featureVector);
+  reference_ = kf;
+  // The frame's matches pass to the keyframe, outliers included: local BA has the last word.
+  for (std::size_t i = 0; i < current_.size(); ++i)
+    if (current_.points[i]) kf->setPoint(i, current_.points[i]);
+  // Close stereo points become map points at once (paper §III-A); far ones only while fewer than
+  // 100 points were added, nearest first.
+  std::vector<std::pair<float, std::size_t>> byDepth;
+  for (std::size_t i = 0; i < current_.size(); ++i)
+    if (current_.features->depth[i] > 0) byDepth.emplace_back(current_.features->depth[i], i);
+  std::sort(byDepth.begin(), byDepth.end());
+  int points = 0;
+  for (const auto& [z, i] : byDepth) {
+    MapPoint* existing = current_.points[i];
+    if (!existing || existing->observationCount() < 1) {
+      Eigen::Vector3d pw;
+      current_.unprojectStereo(i, pw);
+      MapPoint* p = map_.createMapPoint(pw, kf, current_.index);
+      p->addObservation(kf, i);
+      kf->setPoint(i, p);
+      p->computeDistinctiveDescriptor();
+      p->updateNormalAndDepth();
+      current_.points[i] = p;
+      current_.outlier[i] = 0;
+    }
+    ++points;
+    if (z > current_.intrinsics.closeDepth && points > 100) break;
+  }
+  lastKeyFrame_ = kf;
+  lastKeyFrameFrame_ = current_.index;
+  if (mapper_) {
+    mapper_->insertKeyFrame(kf);
+    mapper_->setNotStop(false);
+  }
+}
+
+}  // namespace orbis
