@@ -1,0 +1,96 @@
+// orbis/mapping/local_mapper.hpp — the local-mapping thread of the paper (§III; ORB-SLAM §VI).
+//
+// Contract: keyframes handed over by tracking are processed in order: insertion (observations,
+// covisibility), culling of recent points that are rarely found, triangulation of new points
+// with the covisible keyframes, fusion of duplicates in the neighbourhood, local BA, and culling
+// of keyframes whose points 90% of which are seen by three others at the same or finer scale.
+// Threaded: a worker thread consumes the queue (local BA can be interrupted by tracking).
+// Deterministic: nothing runs until the owner calls runUntilIdle(), which processes the whole
+// queue on the caller's thread. Each step holds Map::mutex(); local BA solves on a copy
+// outside it. Processed keyframes are passed to the keyframe sink (loop closing).
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <list>
+#include <mutex>
+#include <thread>
+
+#include "orbis/map/map.hpp"
+#include "orbis/util/timing.hpp"
+
+namespace orbis {
+
+struct LocalMapperOptions {
+  bool threaded = true;
+  int triangulationNeighbours = 10;  // covisible keyframes searched for new points (stereo)
+  double redundancyRatio = 0.9;      // keyframe culling: share of points seen elsewhere
+  bool cullKeyFrames = true;
+};
+
+class LocalMapper {
+ public:
+  LocalMapper(Map& map, LocalMapperOptions options, StageTimer* timer = nullptr);
+  ~LocalMapper();
+  LocalMapper(const LocalMapper&) = delete;
+  LocalMapper& operator=(const LocalMapper&) = delete;
+
+  // Called by tracking (with the map mutex held): queue a new keyframe.
+  void insertKeyFrame(KeyFrame* kf);
+  std::size_t queuedKeyFrames() const;
+  bool acceptsKeyFrames() const { return acceptKeyFrames_.load(); }
+  void interruptBundleAdjustment() { abortBA_ = true; }
+
+  // Loop closing pauses local mapping while it corrects the map.
+  void requestStop();
+  bool isStopped() const;
+  bool isStoppedOrStopping() const;
+  // While set, a stop request is not honoured (tracking is creating a keyframe). Returns false
+  // when the mapper is already stopped.
+  bool setNotStop(bool flag);
+  void release();
+
+  // Deterministic mode: process every queued keyframe now, on this thread.
+  void runUntilIdle();
+  // Threaded mode: block until the queue is empty and the worker is idle.
+  void waitUntilIdle();
+  void shutdown();
+
+  void setKeyFrameSink(std::function<void(KeyFrame*)> sink) { sink_ = std::move(sink); }
+  // Drops points that recent keyframes created but are no longer bad-checked (reset support).
+  std::size_t processedKeyFrames() const { return processed_.load(); }
+
+ private:
+  void run();
+  bool processOne();
+  void processNewKeyFrame(KeyFrame* kf);
+  void cullRecentPoints(KeyFrame* kf);
+  void createNewMapPoints(KeyFrame* kf);
+  void fuseWithNeighbours(KeyFrame* kf);
+  void cullKeyFrames(KeyFrame* kf);
+  bool stopIfRequested();
+
+  Map& map_;
+  LocalMapperOptions options_;
+  StageTimer* timer_;
+  std::function<void(KeyFrame*)> sink_;
+
+  mutable std::mutex queueMutex_;
+  std::condition_variable queueCv_;
+  std::deque<KeyFrame*> queue_;
+  std::list<MapPoint*> recentPoints_;
+  std::atomic<bool> acceptKeyFrames_{true};
+  std::atomic<bool> abortBA_{false};
+  std::atomic<bool> busy_{false};
+  std::atomic<bool> finish_{false};
+  std::atomic<std::size_t> processed_{0};
+
+  mutable std::mutex stopMutex_;
+  bool stopRequested_ = false, stopped_ = false, notStop_ = false;
+
+  std::thread worker_;
+};
+
+}  // namespace orbis
