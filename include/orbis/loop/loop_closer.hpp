@@ -1,0 +1,148 @@
+// orbis/loop/loop_closer.hpp — the loop-closing thread of the paper (§III-D; ORB-SLAM §VII) and
+// its full-BA worker, for metric sensors (stereo, RGB-D: SE(3) loops).
+//
+// Contract: keyframes come from local mapping (insertKeyFrame, the LocalMapper's keyframe sink)
+// and are processed in order. Each is added to the keyframe database; loop candidates are those
+// of bow::KeyframeDatabase::detectLoopCandidates kept only when their covisibility group stays
+// consistent over `consistencyThreshold` consecutive keyframes. For each such candidate: bag-of-
+// words matches, an SE(3) by RANSAC over 3-point alignments (generator seeded by options.seed),
+// guided matching and pose refinement; accepted with ≥ minPoseInliers, then ≥ minLoopMatches
+// after projecting the candidate's neighbourhood. The correction: local mapping paused, the
+// current keyframe and its covisible keyframes (and their points) moved by the loop transform,
+// duplicated points merged, covisibility updated, loop edges added, the essential graph
+// optimised (spanning tree, loop edges, covisibility ≥ essentialGraphMinWeight; the loop
+// keyframe fixed), Map::notifyBigChange(), then full BA. Full BA runs on its own thread in
+// threaded mode — aborted and restarted when a new loop closes — and inline in deterministic
+// mode; its result is merged under the map lock with local mapping paused: optimised keyframes
+// take their new poses, keyframes created meanwhile follow their spanning-tree parent, points
+// created meanwhile follow their reference keyframe.
+// Threaded: a worker consumes the queue. Deterministic: nothing runs until runUntilIdle(), which
+// does everything (full BA included) on the caller's thread, so results are bit-identical.
+// Each step holds Map::mutex(); the essential graph and full BA solve on copies outside it.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "orbis/bow/keyframe_database.hpp"
+#include "orbis/map/map.hpp"
+#include "orbis/util/timing.hpp"
+
+namespace orbis {
+
+class LocalMapper;
+
+struct LoopCloserOptions {
+  bool threaded = true;
+  std::uint32_t seed = 0;               // RANSAC generator
+  int consistencyThreshold = 3;         // consecutive keyframes a candidate group must persist
+  int keyFramesAfterLoop = 10;          // no detection this soon after the last loop (ORB-SLAM)
+  int minBowMatches = 20;               // candidate needs this many bag-of-words matches
+  int minPoseInliers = 20;              // after guided matching and refinement
+  int minLoopMatches = 40;              // after projecting the loop neighbourhood
+  int essentialGraphMinWeight = 100;    // covisibility edges kept in the essential graph
+  bool fullBundleAdjustment = true;
+  int fullBundleAdjustmentIterations = 10;
+  // Receives "loop closed: ..." lines; null prints them to stderr.
+  std::function<void(const std::string&)> log;
+};
+
+struct LoopClosureEvent {
+  KeyFrameId current = 0, loop = 0;
+  std::uint64_t frameIndex = 0;  // frame the current keyframe was made from
+  int inliers = 0;               // matched points after the projection search
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(Map& map, LocalMapper* mapper, bow::KeyframeDatabase& database, LoopCloserOptions options,
+             StageTimer* timer = nullptr);
+  ~LoopCloser();
+  LoopCloser(const LoopCloser&) = delete;
+  LoopCloser& operator=(const LoopCloser&) = delete;
+
+  // Local mapping's keyframe sink (any thread).
+  void insertKeyFrame(KeyFrame* kf);
+  // Deterministic mode: process every queued keyframe now, on this thread.
+  void runUntilIdle();
+  // Block until the queue is empty, the worker idle and no full BA is running.
+  void waitUntilIdle();
+  void shutdown();
+
+  std::vector<LoopClosureEvent> closures() const;
+  int fullBundleAdjustmentsMerged() const { return fullBaMerged_.load(); }
+  bool fullBundleAdjustmentRunning() const { return fullBaRunning_.load(); }
+
+ private:
+  struct ConsistentGroup {
+    std::set<KeyFrameId> members;
+    int consistency = 0;
+  };
+  struct LoopCandidate {
+    KeyFrame* loopKeyFrame = nullptr;
+    SE3d correctedTcw;                  // the current keyframe's pose seen from the loop side
+    std::vector<MapPoint*> matches;     // per keypoint of the current keyframe: loop-side point
+    std::vector<MapPoint*> loopPoints;  // points of the loop keyframe's neighbourhood
+    int matched = 0;
+  };
+
+  void run();
+  bool processOne();
+  // Holding the map mutex:
+  void dropBadKeyFrames();
+  std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf);
+  bool computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out);
+  // Takes the map mutex itself (pauses local mapping first):
+  void correctLoop(KeyFrame* kf, LoopCandidate& loop);
+  using PoseMap = std::map<KeyFrame*, SE3d, ById>;
+  using LinkMap = std::map<KeyFrame*, std::set<KeyFrame*, ById>, ById>;
+  using PointCorrectors = std::map<MapPoint*, KeyFrame*, ById>;
+  void optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected, const LinkMap& loopLinks,
+                              const PointCorrectors& correctedBy);
+  void startFullBundleAdjustment();
+  void runFullBundleAdjustment();
+  void stopFullBundleAdjustment();
+  void pauseMapping();
+  void resumeMapping();
+  void report(const std::string& line) const;
+
+  Map& map_;
+  LocalMapper* mapper_;
+  bow::KeyframeDatabase& database_;
+  LoopCloserOptions options_;
+  StageTimer* timer_;
+  std::mt19937 rng_;
+
+  mutable std::mutex queueMutex_;
+  std::condition_variable queueCv_;
+  std::deque<KeyFrame*> queue_;
+  std::atomic<bool> busy_{false};
+  std::atomic<bool> finish_{false};
+
+  std::vector<KeyFrame*> indexed_;  // keyframes in the database (loop thread only)
+  std::vector<ConsistentGroup> consistentGroups_;
+  KeyFrameId lastLoopKeyFrame_ = 0;
+  bool anyLoop_ = false;
+
+  mutable std::mutex eventsMutex_;
+  std::vector<LoopClosureEvent> events_;
+
+  std::thread fullBaThread_;
+  std::atomic<bool> abortFullBa_{false};
+  std::atomic<bool> fullBaRunning_{false};
+  std::atomic<int> fullBaMerged_{0};
+
+  std::thread worker_;
+};
+
+}  // namespace orbis

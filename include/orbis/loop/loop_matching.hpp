@@ -1,0 +1,33 @@
+// orbis/loop/loop_matching.hpp — the descriptor searches of loop closing (ORB-SLAM §VII-B, C).
+//
+// Contract: every search compares 256-bit ORB descriptors by Hamming distance between a keyframe
+// and map points or another keyframe, writes its matches into one slot per keypoint of the
+// first keyframe (null when unmatched) and returns how many slots it filled. Callers hold
+// Map::mutex(). Candidates are visited in index order and ties keep the first, so results are
+// deterministic.
+//  - matchKeyFramesByBow: keyframe-to-keyframe, both keypoints owning map points, candidates
+//    grouped by vocabulary node, best distance ≤ TH_LOW and < ratio × second best, rotation
+//    consistency.
+//  - matchByRelativePose: with T12 (camera 1 from camera 2), the points of each keyframe are
+//    projected into the other; a pair is kept when both directions agree (ORB-SLAM's
+//    SearchBySim3 with the scale fixed to 1). Existing matches in `matches12` are kept.
+//  - matchByProjection: `points` projected into keyframe `kf` at pose Tcw (which may differ from
+//    kf.Tcw(): the loop-corrected pose), skipping points already matched in `matches`.
+#pragma once
+
+#include <vector>
+
+#include "orbis/map/map.hpp"
+
+namespace orbis::loop {
+
+int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<MapPoint*>& matches12,
+                        float ratio = 0.75f);
+
+int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
+                        float radius = 7.5f);
+
+int matchByProjection(const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
+                      std::vector<MapPoint*>& matches, float radius = 10.0f);
+
+}  // namespace orbis::loop

@@ -1,0 +1,41 @@
+// orbis/loop/map_covisibility.hpp — the map's covisibility graph in the shape the keyframe
+// database's place queries ask for (bow::CovisibilityGraph).
+//
+// Contract: a view of a Map, answering by keyframe id; unknown and bad keyframes have no
+// neighbours, and bad neighbours are left out. Callers hold Map::mutex() for the query.
+#pragma once
+
+#include <vector>
+
+#include "orbis/bow/keyframe_database.hpp"
+#include "orbis/map/map.hpp"
+
+namespace orbis::loop {
+
+class MapCovisibility {
+ public:
+  explicit MapCovisibility(const Map& map) : map_(map) {}
+
+  std::vector<bow::KeyframeId> connectedKeyframes(bow::KeyframeId id) const {
+    std::vector<bow::KeyframeId> out;
+    if (const KeyFrame* kf = map_.keyFrame(id); kf && !kf->isBad())
+      for (const KeyFrame* n : kf->covisibles())
+        if (!n->isBad()) out.push_back(n->id);
+    return out;
+  }
+
+  std::vector<bow::KeyframeId> bestCovisibleKeyframes(bow::KeyframeId id, std::size_t n) const {
+    std::vector<bow::KeyframeId> out;
+    if (const KeyFrame* kf = map_.keyFrame(id); kf && !kf->isBad())
+      for (const KeyFrame* c : kf->bestCovisibles(n))
+        if (!c->isBad()) out.push_back(c->id);
+    return out;
+  }
+
+ private:
+  const Map& map_;
+};
+
+static_assert(bow::CovisibilityGraph<MapCovisibility>);
+
+}  // namespace orbis::loop

@@ -1,0 +1,251 @@
+// The loop correction half of LoopCloser: loop fusion, essential graph, full BA and its merge.
+#include <algorithm>
+#include <cstdio>
+
+#include "orbis/loop/loop_closer.hpp"
+#include "orbis/mapping/bundle_adjustment.hpp"
+#include "orbis/mapping/local_mapper.hpp"
+#include "orbis/optim/pose_graph.hpp"
+#include "orbis/tracking/map_matching.hpp"
+
+namespace orbis {
+
+namespace {
+
+MapPoint* followReplacements(MapPoint* p) {
+  while (p && p->isBad() && p->replacement()) p = p->replacement();
+  return p && !p->isBad() ? p : nullptr;
+}
+
+}  // namespace
+
+void LoopCloser::pauseMapping() {
+  if (!options_.threaded || !mapper_) return;  // deterministic: mapping is idle between calls
+  mapper_->requestStop();
+  while (!mapper_->isStopped() && !finish_) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
+void LoopCloser::resumeMapping() {
+  if (options_.threaded && mapper_) mapper_->release();
+}
+
+void LoopCloser::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
+  // A full BA still running would merge a map this correction has already moved.
+  stopFullBundleAdjustment();
+  pauseMapping();
+  KeyFrame* loopKf = loop.loopKeyFrame;
+  PoseMap nonCorrected;
+  LinkMap loopLinks;
+  PointCorrectors correctedBy;
+  {
+    std::lock_guard lock(map_.mutex());
+    kf->updateConnections();
+    // The current keyframe and its neighbours move rigidly with the loop transform.
+    std::vector<KeyFrame*> connected{kf};
+    for (KeyFrame* n : kf->covisibles())
+      if (!n->isBad()) connected.push_back(n);
+    const SE3d Twc = kf->Twc();
+    PoseMap corrected;
+    for (KeyFrame* k : connected) {
+      nonCorrected[k] = k->Tcw();
+      corrected[k] = k == kf ? loop.correctedTcw : (k->Tcw() * Twc) * loop.correctedTcw;
+    }
+    for (const auto& [k, Tcw] : corrected) {
+      const SE3d Twc_corrected = Tcw.inverse();
+      const SE3d& Tcw_old = nonCorrected[k];
+      for (MapPoint* p : k->goodPoints()) {
+        if (!correctedBy.emplace(p, k).second) continue;
+        p->setPosition(Twc_corrected * (Tcw_old * p->position()));
+      }
+      k->setPose(Tcw);
+    }
+    for (const auto& [p, k] : correctedBy) p->updateNormalAndDepth();
+    for (KeyFrame* k : connected) k->updateConnections();
+
+    // Loop fusion: the current keyframe's matches become the loop side's points.
+    for (std::size_t i = 0; i < loop.matches.size(); ++i) {
+      MapPoint* loopPoint = followReplacements(loop.matches[i]);
+      if (!loopPoint) continue;
+      MapPoint* own = kf->point(i);
+      if (own && !own->isBad()) {
+        if (own != loopPoint) own->replaceWith(loopPoint);
+      } else if (!loopPoint->isObservedBy(kf)) {
+        kf->setPoint(i, loopPoint);
+        loopPoint->addObservation(kf, i);
+        loopPoint->computeDistinctiveDescriptor();
+      }
+    }
+    // Duplicates in the neighbourhood, now that both sides agree.
+    std::vector<MapPoint*> loopPoints;
+    for (MapPoint* p : loop.loopPoints)
+      if (MapPoint* q = followReplacements(p)) loopPoints.push_back(q);
+    for (KeyFrame* k : connected)
+      if (!k->isBad()) matching::fuse(*k, loopPoints, 4.0f);
+
+    // Links the fusion created between the two sides of the loop.
+    for (KeyFrame* k : connected) {
+      if (k->isBad()) continue;
+      const std::vector<KeyFrame*> previous = k->covisibles();
+      k->updateConnections();
+      std::set<KeyFrame*, ById> links = k->connectedSet();
+      for (KeyFrame* n : previous) links.erase(n);
+      for (KeyFrame* n : connected) links.erase(n);
+      if (!links.empty()) loopLinks[k] = std::move(links);
+    }
+    loopKf->addLoopEdge(kf);
+    kf->addLoopEdge(loopKf);
+  }
+  optimiseEssentialGraph(kf, loopKf, nonCorrected, loopLinks, correctedBy);
+  map_.notifyBigChange();
+  anyLoop_ = true;
+  lastLoopKeyFrame_ = kf->id;
+  const LoopClosureEvent event{kf->id, loopKf->id, kf->frameIndex, loop.matched};
+  {
+    std::lock_guard lock(eventsMutex_);
+    events_.push_back(event);
+  }
+  char line[160];
+  std::snprintf(line, sizeof line, "loop closed: keyframe %llu <-> keyframe %llu (frame %llu), %d inliers",
+                static_cast<unsigned long long>(event.current), static_cast<unsigned long long>(event.loop),
+                static_cast<unsigned long long>(event.frameIndex), event.inliers);
+  report(line);
+  resumeMapping();
+  if (options_.fullBundleAdjustment) startFullBundleAdjustment();
+}
+
+void LoopCloser::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected,
+                                        const LinkMap& loopLinks, const PointCorrectors& correctedBy) {
+  std::vector<KeyFrame*> keyFrames;
+  std::vector<SE3d> poses, before;
+  std::vector<char> fixed;
+  std::vector<optim::PoseGraphEdgeSE3> edges;
+  {
+    std::lock_guard lock(map_.mutex());
+    keyFrames = map_.keyFrames();
+    std::map<const KeyFrame*, int> index;
+    for (KeyFrame* k : keyFrames) {
+      index[k] = static_cast<int>(poses.size());
+      poses.push_back(k->Tcw());
+      fixed.push_back(k == loopKf ? 1 : 0);
+    }
+    before = poses;
+    // The pose a keyframe had before the loop moved it: the measurement of its old edges.
+    auto oldPose = [&](KeyFrame* k) {
+      const auto it = nonCorrected.find(k);
+      return it != nonCorrected.end() ? it->second : k->Tcw();
+    };
+    std::set<std::pair<int, int>> inserted;
+    auto addEdge = [&](KeyFrame* a, KeyFrame* b, const SE3d& Taw, const SE3d& Tbw) {
+      const auto ia = index.find(a), ib = index.find(b);
+      if (ia == index.end() || ib == index.end()) return;
+      const auto key = std::minmax(ia->second, ib->second);
+      if (!inserted.insert(key).second) return;
+      edges.push_back({ia->second, ib->second, Taw * Tbw.inverse(), 1.0});
+    };
+    // New loop links, measured with the corrected poses (they are what the loop says).
+    for (const auto& [k, links] : loopLinks)
+      for (KeyFrame* n : links) {
+        if ((k != kf || n != loopKf) && k->weight(n) < options_.essentialGraphMinWeight) continue;
+        addEdge(k, n, k->Tcw(), n->Tcw());
+      }
+    for (KeyFrame* k : keyFrames) {
+      const SE3d Tkw = oldPose(k);
+      if (KeyFrame* parent = k->parent(); parent && !parent->isBad()) addEdge(k, parent, Tkw, oldPose(parent));
+      for (KeyFrame* l : k->loopEdges())
+        if (!l->isBad() && l->id < k->id) addEdge(k, l, Tkw, oldPose(l));
+      for (KeyFrame* n : k->covisiblesWithWeightAtLeast(options_.essentialGraphMinWeight)) {
+        if (n->isBad() || n->id >= k->id || n == k->parent() || k->hasChild(n) || k->loopEdges().count(n)) continue;
+        addEdge(k, n, Tkw, oldPose(n));
+      }
+    }
+  }
+  optim::optimizePoseGraph(poses, fixed, edges);
+
+  std::lock_guard lock(map_.mutex());
+  std::map<const KeyFrame*, std::size_t> index;
+  for (std::size_t i = 0; i < keyFrames.size(); ++i) index[keyFrames[i]] = i;
+  // Points move with the keyframe that last corrected them: the loop's corrector, else their
+  // reference keyframe.
+  for (MapPoint* p : map_.mapPoints()) {
+    const auto c = correctedBy.find(p);
+    const KeyFrame* ref = c != correctedBy.end() ? c->second : p->reference();
+    const auto it = ref ? index.find(ref) : index.end();
+    if (it == index.end()) continue;
+    const std::size_t i = it->second;
+    p->setPosition(poses[i].inverse() * (before[i] * p->position()));
+  }
+  for (std::size_t i = 0; i < keyFrames.size(); ++i)
+    if (!keyFrames[i]->isBad()) keyFrames[i]->setPose(poses[i]);
+  for (MapPoint* p : map_.mapPoints()) p->updateNormalAndDepth();
+}
+
+void LoopCloser::stopFullBundleAdjustment() {
+  if (!fullBaThread_.joinable()) return;
+  abortFullBa_ = true;
+  fullBaThread_.join();
+  abortFullBa_ = false;
+}
+
+void LoopCloser::startFullBundleAdjustment() {
+  stopFullBundleAdjustment();
+  fullBaRunning_ = true;
+  if (!options_.threaded) {
+    runFullBundleAdjustment();
+    fullBaRunning_ = false;
+    return;
+  }
+  fullBaThread_ = std::thread([this] {
+    runFullBundleAdjustment();
+    fullBaRunning_ = false;
+  });
+}
+
+void LoopCloser::runFullBundleAdjustment() {
+  FullBundleAdjustmentResult result;
+  {
+    ScopedStage stage(timer_, "loop: full BA");
+    result = fullBundleAdjustment(map_, options_.fullBundleAdjustmentIterations, &abortFullBa_);
+  }
+  if (result.aborted || abortFullBa_) return;
+  pauseMapping();
+  {
+    ScopedStage stage(timer_, "loop: full BA merge");
+    std::lock_guard lock(map_.mutex());
+    // Keyframes: optimised ones take their new pose; the others (created meanwhile) follow their
+    // spanning-tree parent, visited from the root down.
+    PoseMap before;
+    for (KeyFrame* k : map_.keyFrames()) before[k] = k->Tcw();
+    std::vector<KeyFrame*> stack;
+    if (KeyFrame* root = map_.origin(); root && !root->isBad()) stack.push_back(root);
+    for (KeyFrame* k : map_.keyFrames())
+      if (!k->parent() && k != map_.origin()) stack.push_back(k);  // a second root, if any
+    std::set<KeyFrame*, ById> visited;
+    while (!stack.empty()) {
+      KeyFrame* k = stack.back();
+      stack.pop_back();
+      if (!visited.insert(k).second) continue;
+      if (const auto it = result.keyFramePoses.find(k->id); it != result.keyFramePoses.end()) {
+        k->setPose(it->second);
+      } else if (KeyFrame* parent = k->parent(); parent && before.count(parent) && before.count(k)) {
+        // T_kw' = T_kp · T_pw', with T_kp as it was before the merge.
+        k->setPose(before[k] * before[parent].inverse() * parent->Tcw());
+      }
+      for (KeyFrame* child : k->children())
+        if (!child->isBad()) stack.push_back(child);
+    }
+    // Points: optimised ones take their new position, the others follow their reference.
+    for (MapPoint* p : map_.mapPoints()) {
+      if (const auto it = result.pointPositions.find(p->id); it != result.pointPositions.end()) {
+        p->setPosition(it->second);
+      } else if (KeyFrame* ref = p->reference(); ref && before.count(ref)) {
+        p->setPosition(ref->Tcw().inverse() * (before[ref] * p->position()));
+      }
+      p->updateNormalAndDepth();
+    }
+  }
+  map_.notifyBigChange();
+  ++fullBaMerged_;
+  resumeMapping();
+}
+
+}  // namespace orbis

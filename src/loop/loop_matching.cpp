@@ -1,0 +1,161 @@
+#include "orbis/loop/loop_matching.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "orbis/tracking/map_matching.hpp"
+
+namespace orbis::loop {
+
+namespace {
+
+using matching::kThHigh;
+using matching::kThLow;
+
+// Where a point seen from pose Tcw should appear in `kf`, and the pyramid level it predicts;
+// false when it is behind the camera, off the image or outside its scale-invariance range.
+bool predict(const KeyFrame& kf, const SE3d& Tcw, const Eigen::Vector3d& world, const MapPoint& point, float& u,
+             float& v, int& level, bool checkViewAngle) {
+  const Eigen::Vector3d pc = Tcw * world;
+  if (pc.z() <= 0) return false;
+  const MapIntrinsics& K = kf.intrinsics;
+  const double x = K.fx * pc.x() / pc.z() + K.cx, y = K.fy * pc.y() / pc.z() + K.cy;
+  if (!K.inImage(x, y)) return false;
+  const Eigen::Vector3d po = world - Tcw.inverse().translation();
+  const auto dist = static_cast<float>(po.norm());
+  if (dist < point.minDistanceInvariance() || dist > point.maxDistanceInvariance()) return false;
+  if (checkViewAngle && point.normal().norm() > 0 && po.dot(point.normal()) < 0.5 * dist * point.normal().norm())
+    return false;
+  const ScaleLevels& levels = kf.features().scales;
+  level = point.predictScale(dist, levels.levels(), levels.logFactor());
+  u = static_cast<float>(x);
+  v = static_cast<float>(y);
+  return true;
+}
+
+// Best keypoint of `kf` near (u, v) for `descriptor`, at most `maxDistance` away in Hamming
+// distance; -1 when none.
+long bestInArea(const KeyFrame& kf, float u, float v, int level, float radius, const OrbDescriptor& descriptor,
+                int maxDistance, const std::vector<MapPoint*>* taken) {
+  const FrameFeatures& f = kf.features();
+  const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
+  int bestDist = 256;
+  long best = -1;
+  for (int j : f.grid.featuresInArea(u, v, r, level - 1, level + 1)) {
+    const auto sj = static_cast<std::size_t>(j);
+    if (taken && (*taken)[sj]) continue;
+    const int d = hammingDistance(descriptor, f.descriptors[sj]);
+    if (d < bestDist) {
+      bestDist = d;
+      best = j;
+    }
+  }
+  return bestDist <= maxDistance ? best : -1;
+}
+
+}  // namespace
+
+int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<MapPoint*>& matches12, float ratio) {
+  const FrameFeatures& f1 = kf1.features();
+  const FrameFeatures& f2 = kf2.features();
+  matches12.assign(kf1.size(), nullptr);
+  std::vector<char> taken2(kf2.size(), 0);
+  matching::RotationHistogram hist;
+  const auto& a = kf1.featureVector();
+  const auto& b = kf2.featureVector();
+  int matches = 0;
+  std::size_t ia = 0, ib = 0;
+  while (ia < a.size() && ib < b.size()) {
+    if (a.node(ia) < b.node(ib)) { ++ia; continue; }
+    if (b.node(ib) < a.node(ia)) { ++ib; continue; }
+    for (std::uint32_t i : a.featuresOf(ia)) {
+      MapPoint* p1 = kf1.point(i);
+      if (!p1 || p1->isBad()) continue;
+      int bestDist = 256, secondDist = 256;
+      long best = -1;
+      for (std::uint32_t j : b.featuresOf(ib)) {
+        MapPoint* p2 = kf2.point(j);
+        if (taken2[j] || !p2 || p2->isBad()) continue;
+        const int d = hammingDistance(f1.descriptors[i], f2.descriptors[j]);
+        if (d < bestDist) { secondDist = bestDist; bestDist = d; best = j; }
+        else if (d < secondDist) secondDist = d;
+      }
+      if (best >= 0 && bestDist < kThLow && bestDist < ratio * static_cast<float>(secondDist)) {
+        const auto j = static_cast<std::size_t>(best);
+        matches12[i] = kf2.point(j);
+        taken2[j] = 1;
+        hist.add(f1.keypointsUn[i].angle - f2.keypointsUn[j].angle, i);
+        ++matches;
+      }
+    }
+    ++ia;
+    ++ib;
+  }
+  for (std::size_t i : hist.outliers()) {
+    if (matches12[i]) {
+      matches12[i] = nullptr;
+      --matches;
+    }
+  }
+  return matches;
+}
+
+int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
+                        float radius) {
+  const SE3d T21 = T12.inverse();
+  const SE3d T1w = kf1.Tcw(), T2w = kf2.Tcw();
+  // Pose of camera 1 (resp. 2) expressed so the other keyframe's world points land in it.
+  const SE3d T1w_via2 = T12 * T2w;  // world (as kf2 sees it) -> camera 1
+  const SE3d T2w_via1 = T21 * T1w;  // world (as kf1 sees it) -> camera 2
+  std::set<MapPoint*, ById> alreadyMatched;
+  for (MapPoint* p : matches12)
+    if (p) alreadyMatched.insert(p);
+
+  // kf2's points into kf1.
+  std::vector<long> match1to2(kf1.size(), -1);
+  for (std::size_t j = 0; j < kf2.size(); ++j) {
+    MapPoint* p = kf2.point(j);
+    if (!p || p->isBad() || alreadyMatched.count(p)) continue;
+    float u, v;
+    int level;
+    if (!predict(kf1, T1w_via2, p->position(), *p, u, v, level, false)) continue;
+    const long i = bestInArea(kf1, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (i >= 0 && !matches12[static_cast<std::size_t>(i)]) match1to2[static_cast<std::size_t>(i)] = static_cast<long>(j);
+  }
+  // kf1's points into kf2; keep the pairs both directions chose.
+  int added = 0;
+  for (std::size_t i = 0; i < kf1.size(); ++i) {
+    MapPoint* p = kf1.point(i);
+    if (!p || p->isBad() || matches12[i] || match1to2[i] < 0) continue;
+    float u, v;
+    int level;
+    if (!predict(kf2, T2w_via1, p->position(), *p, u, v, level, false)) continue;
+    const long j = bestInArea(kf2, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (j != match1to2[i]) continue;
+    matches12[i] = kf2.point(static_cast<std::size_t>(j));
+    ++added;
+  }
+  return added;
+}
+
+int matchByProjection(const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
+                      std::vector<MapPoint*>& matches, float radius) {
+  std::set<MapPoint*, ById> alreadyMatched;
+  for (MapPoint* p : matches)
+    if (p) alreadyMatched.insert(p);
+  int added = 0;
+  for (MapPoint* p : points) {
+    if (!p || p->isBad() || alreadyMatched.count(p)) continue;
+    float u, v;
+    int level;
+    if (!predict(kf, Tcw, p->position(), *p, u, v, level, true)) continue;
+    const long i = bestInArea(kf, u, v, level, radius, p->descriptor(), kThLow, &matches);
+    if (i < 0) continue;
+    matches[static_cast<std::size_t>(i)] = p;
+    alreadyMatched.insert(p);
+    ++added;
+  }
+  return added;
+}
+
+}  // namespace orbis::loop
