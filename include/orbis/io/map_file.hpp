@@ -1,0 +1,51 @@
+// orbis/io/map_file.hpp — saving a map and loading it in a later run (paper §III-F reuse).
+//
+// Contract: a map file is little-endian binary:
+//   header: magic "ORBISMAP", format version (kMapFileVersion), sensor kind, total file size,
+//           vocabulary checksum, the camera (MapIntrinsics), keyframe and map-point counts;
+//   keyframes (good ones, by id): frame index, timestamp, pose, intrinsics, features (keypoints,
+//           undistorted keypoints, descriptors, uRight, depth, close-depth threshold, scale
+//           tables, grid bounds — the grid is rebuilt on load), BoW and feature vectors,
+//           spanning-tree parent, loop edges, covisibility edges with weights;
+//   map points (good ones, by id): position, reference keyframe, creating frame, descriptor,
+//           visible/found counters, observations (keyframe, keypoint index);
+//   trailer: bow::checksum64 of everything before it.
+// Ids in the file are those of the saving map; loading creates keyframes and points afresh in
+// the same order (ids are renumbered densely, order preserved). The mean viewing direction and
+// the scale-invariance distances are recomputed from the observations (the same computation on
+// the same data). readMapFile checks, in this order, size, magic, version, declared size,
+// checksum, then the caller's expectations (sensor, vocabulary, camera), and throws
+// orbis::Error naming the file and the defect — nothing is added to the map on failure.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+#include "orbis/camera/sensor_kind.hpp"
+#include "orbis/map/map.hpp"
+#include "orbis/tracking/tracker.hpp"
+
+namespace orbis {
+
+inline constexpr std::uint32_t kMapFileVersion = 1;
+
+struct MapFileInfo {
+  SensorKind sensor = SensorKind::Stereo;
+  MapIntrinsics intrinsics;  // of the system that saved it (fx, fy, cx, cy, bf are checked)
+  std::uint64_t vocabularyChecksum = 0;
+  std::uint64_t keyFrames = 0, mapPoints = 0;
+};
+
+// Identifies the vocabulary a map's BoW vectors belong to (checksum of its whole file block).
+std::uint64_t vocabularyChecksum(const OrbVocabulary& vocabulary);
+
+// Writes the good keyframes and points of `map`. Caller holds map.mutex(). Written to a
+// temporary file renamed into place, so a crash never leaves half a map under `file`.
+void writeMapFile(const std::filesystem::path& file, const Map& map, const MapFileInfo& info);
+
+// Reads `file` into `map`, which must be empty; `expected` gives the sensor, vocabulary
+// checksum and camera it must have been made with. Caller holds map.mutex(). Returns the
+// file's header (counts as loaded).
+MapFileInfo readMapFile(const std::filesystem::path& file, Map& map, const MapFileInfo& expected);
+
+}  // namespace orbis
