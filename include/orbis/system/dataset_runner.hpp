@@ -1,0 +1,58 @@
+// orbis/system/dataset_runner.hpp — SLAM over a whole dataset sequence, with its outputs.
+//
+// Contract: runDataset reads the sequence frame by frame through a DatasetReader, picks the
+// compile-time sensor configuration once from the dataset's sensor (Slam<Stereo> or
+// Slam<Rgbd>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
+// camera-to-world, every tracked frame), keyframes.txt (TUM), report.json (frame counts,
+// keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE when the dataset
+// has ground truth), map.ply (map points) and overview.png (top view). A frame that cannot be
+// read or tracked is reported and survived; outputs computed so far are still written if a
+// later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
+// else from the dataset's own calibration.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "orbis/adapters/dataset.hpp"
+#include "orbis/system/slam.hpp"
+
+namespace orbis {
+
+struct RunOptions {
+  std::optional<std::filesystem::path> settings;
+  std::filesystem::path vocabulary;
+  std::filesystem::path outDir = "out";
+  bool deterministic = false;
+  bool localisationOnly = false;
+  bool loopClosing = true;
+  std::optional<std::filesystem::path> denseCloud;  // RGB-D: back-projected keyframe depth maps
+  std::size_t maxFrames = 0;                        // 0: all
+  bool progress = true;
+  std::optional<std::filesystem::path> loadMap;  // map file to localise in (io/map_file.hpp)
+  std::optional<std::filesystem::path> saveMap;  // where to save the final map
+};
+
+struct RunReport {
+  std::string dataset, sensor;
+  SlamStats stats;
+  std::vector<StageStats> timing;
+  std::optional<double> ateRmse;  // metres, SE(3) alignment
+  std::size_t ateMatched = 0;
+  double pathLength = 0;          // of the ground truth over the matched poses, metres
+  std::vector<std::string> warnings;
+  double seconds = 0;
+  std::size_t keyFramesLoaded = 0;  // from RunOptions::loadMap
+  std::size_t relocalisationAttempts = 0, relocalisations = 0;
+};
+
+RunReport runDataset(DatasetReader& dataset, const RunOptions& options);
+
+// The vocabulary shipped with orbis: the source tree's vocabulary/ when run from a build, else
+// the installed share/orbis/vocabulary/. Throws orbis::Error when none is found.
+std::filesystem::path defaultVocabularyPath();
+
+}  // namespace orbis

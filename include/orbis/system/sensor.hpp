@@ -1,0 +1,88 @@
+// orbis/system/sensor.hpp — sensor configurations: the compile-time traits Slam<Sensor> runs on.
+//
+// Contract: a sensor configuration names its camera model, its feature extractor, the input one
+// frame brings, and how that input becomes FrameFeatures (paper Fig. 2b). Everything after
+// feature extraction is sensor-agnostic. A new sensor is one more struct meeting
+// SensorConfiguration, not a fork of the pipeline.
+#pragma once
+
+#include <concepts>
+
+#include <opencv2/core.hpp>
+
+#include "orbis/camera/camera_model.hpp"
+#include "orbis/camera/sensor_kind.hpp"
+#include "orbis/camera/stereo.hpp"
+#include "orbis/features/frame_features.hpp"
+#include "orbis/features/orb_extractor.hpp"
+#include "orbis/features/stereo_matcher.hpp"
+
+namespace orbis {
+
+struct StereoInput {
+  double timestamp = 0;
+  cv::Mat left, right;  // rectified, 8-bit grey or BGR
+};
+
+struct RgbdInput {
+  double timestamp = 0;
+  cv::Mat image;  // 8-bit grey or BGR
+  cv::Mat depth;  // CV_32F metres, or CV_16U raw (divided by the camera's depthScale); 0 = none
+};
+
+template <class S>
+concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, const typename S::Input& input) {
+  typename S::Camera;
+  typename S::Input;
+  { S::kKind } -> std::convertible_to<SensorKind>;
+  { S::kMetricScale } -> std::convertible_to<bool>;
+  { builder.build(input) } -> std::same_as<FrameFeatures>;
+} && CameraModel<typename S::Camera>;
+
+// A rectified stereo pair: ORB on both images, then stereo matching along rows (§III-A).
+struct Stereo {
+  using Camera = RectifiedStereoCamera<double>;
+  using Input = StereoInput;
+  static constexpr SensorKind kKind = SensorKind::Stereo;
+  static constexpr bool kMetricScale = true;
+  static constexpr bool kDepthFromSensor = false;
+
+  class FeatureBuilder {
+   public:
+    FeatureBuilder(const Camera& camera, const OrbParams& orb) : camera_(camera), left_(orb), right_(orb) {}
+    FrameFeatures build(const Input& in) { return extractStereo(left_, right_, in.left, in.right, camera_, matcher_); }
+
+   private:
+    Camera camera_;
+    OrbExtractor left_, right_;
+    StereoMatcher matcher_;
+  };
+};
+
+// An RGB-D camera: ORB on the colour image, depth turned into a virtual right coordinate.
+struct Rgbd {
+  using Camera = RgbdCamera<double>;
+  using Input = RgbdInput;
+  static constexpr SensorKind kKind = SensorKind::Rgbd;
+  static constexpr bool kMetricScale = true;
+  static constexpr bool kDepthFromSensor = true;
+
+  class FeatureBuilder {
+   public:
+    FeatureBuilder(const Camera& camera, const OrbParams& orb) : camera_(camera), metric_(camera), extractor_(orb) {
+      metric_.depthScale = 1.0;
+    }
+    FrameFeatures build(const Input& in) {
+      return extractRgbd(extractor_, in.image, in.depth, in.depth.depth() == CV_32F ? metric_ : camera_);
+    }
+
+   private:
+    Camera camera_, metric_;  // metric_: the same camera reading depth already in metres
+    OrbExtractor extractor_;
+  };
+};
+
+static_assert(SensorConfiguration<Stereo>);
+static_assert(SensorConfiguration<Rgbd>);
+
+}  // namespace orbis

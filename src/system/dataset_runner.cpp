@@ -1,0 +1,236 @@
+#include "orbis/system/dataset_runner.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
+#include "orbis/eval/metrics.hpp"
+#include "orbis/io/overview.hpp"
+#include "orbis/io/ply.hpp"
+#include "orbis/io/settings.hpp"
+#include "orbis/util/error.hpp"
+#include "orbis/util/json.hpp"
+#include "orbis/util/progress.hpp"
+
+#ifndef ORBIS_INSTALL_DATADIR
+#define ORBIS_INSTALL_DATADIR ""
+#endif
+#ifndef ORBIS_SOURCE_DIR_FOR_DATA
+#define ORBIS_SOURCE_DIR_FOR_DATA ""
+#endif
+
+namespace orbis {
+
+namespace fs = std::filesystem;
+
+fs::path defaultVocabularyPath() {
+  const char* name = "vocabulary/orbis_orb_k10_L5.bin";
+  if (const char* env = std::getenv("ORBIS_VOCABULARY"); env && *env) return env;
+  for (const fs::path base : {fs::path(ORBIS_SOURCE_DIR_FOR_DATA), fs::path(ORBIS_INSTALL_DATADIR) / "orbis"}) {
+    if (base.empty()) continue;
+    if (fs::exists(base / name)) return base / name;
+  }
+  throw Error("vocabulary", "", std::string("no shipped vocabulary found (looked for ") + name +
+                                    " in the source tree and the install prefix); pass --vocab FILE");
+}
+
+namespace {
+
+struct Defaults {
+  int features;
+  double fps;
+};
+
+Defaults datasetDefaults(DatasetKind kind) {
+  switch (kind) {
+    case DatasetKind::TumRgbd: return {1000, 30};
+    case DatasetKind::Euroc: return {1200, 20};
+    case DatasetKind::Kitti: return {2000, 10};
+  }
+  return {1000, 30};
+}
+
+void writeReport(const fs::path& file, const RunReport& r) {
+  JsonWriter w;
+  w.beginObject();
+  w.field("dataset", r.dataset).field("sensor", r.sensor);
+  w.field("frames", r.stats.frames).field("frames_tracked", r.stats.tracked).field("frames_lost", r.stats.lost);
+  w.field("keyframes", r.stats.keyFrames).field("map_points", r.stats.mapPoints);
+  w.field("seconds", r.seconds);
+  w.field("keyframes_loaded", r.keyFramesLoaded);
+  w.field("relocalisation_attempts", r.relocalisationAttempts).field("relocalisations", r.relocalisations);
+  w.key("ate");
+  if (r.ateRmse) {
+    w.beginObject().field("rmse", *r.ateRmse).field("matched", r.ateMatched).field("alignment", "se3");
+    w.field("path_length", r.pathLength).endObject();
+  } else {
+    w.null();
+  }
+  w.key("timing_ms").beginObject();
+  for (const StageStats& s : r.timing) {
+    w.key(s.stage).beginObject().field("count", s.count).field("mean", s.meanMs).field("median", s.medianMs);
+    w.field("p95", s.p95Ms).field("max", s.maxMs).endObject();
+  }
+  w.endObject();
+  w.key("warnings").beginArray();
+  for (const auto& m : r.warnings) w.value(m);
+  w.endArray().endObject();
+  std::ofstream out(file);
+  if (!out) throw fileError(file.string(), "cannot open for writing");
+  out << w.str() << "\n";
+}
+
+template <class Sensor>
+typename Sensor::Input makeInput(const DatasetFrame& f);
+
+template <>
+StereoInput makeInput<Stereo>(const DatasetFrame& f) {
+  return {f.timestamp, f.left, f.right};
+}
+template <>
+RgbdInput makeInput<Rgbd>(const DatasetFrame& f) {
+  return {f.timestamp, f.left, f.depth};
+}
+
+bool inputComplete(const StereoInput& in) { return !in.left.empty() && !in.right.empty(); }
+bool inputComplete(const RgbdInput& in) { return !in.image.empty() && !in.depth.empty(); }
+
+template <class Sensor>
+void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double fps, DatasetReader& dataset,
+             const RunOptions& options, RunReport& report) {
+  auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
+  SlamOptions slamOptions;
+  slamOptions.deterministic = options.deterministic;
+  slamOptions.localisationOnly = options.localisationOnly;
+  slamOptions.loopClosing = options.loopClosing;
+  slamOptions.fps = fps;
+  Slam<Sensor> slam(camera, orb, vocabulary, slamOptions);
+  if (options.loadMap) {
+    slam.core().loadMap(*options.loadMap);
+    report.keyFramesLoaded = slam.core().loadedKeyFrames();
+  }
+
+  const std::size_t n = options.maxFrames ? std::min(options.maxFrames, dataset.size()) : dataset.size();
+  ProgressBar bar("orbis run", n, options.progress);
+  const auto start = std::chrono::steady_clock::now();
+  double lastTimestamp = -std::numeric_limits<double>::infinity();
+  std::exception_ptr failure;
+  try {
+    for (std::size_t i = 0; i < n; ++i) {
+      DatasetFrame frame;
+      try {
+        frame = dataset.frame(i);
+      } catch (const Error& e) {
+        report.warnings.push_back(std::string("frame ") + std::to_string(i) + " skipped: " + e.what());
+        continue;
+      }
+      for (const auto& w : frame.warnings) report.warnings.push_back("frame " + std::to_string(i) + ": " + w);
+      if (!(frame.timestamp > lastTimestamp)) {
+        report.warnings.push_back("frame " + std::to_string(i) + " skipped: timestamp " +
+                                  std::to_string(frame.timestamp) + " does not increase");
+        continue;
+      }
+      const auto input = makeInput<Sensor>(frame);
+      if (!inputComplete(input)) {
+        report.warnings.push_back("frame " + std::to_string(i) + " skipped: incomplete input");
+        continue;
+      }
+      lastTimestamp = frame.timestamp;
+      const TrackResult r = slam.track(input);
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      char status[64];
+      std::snprintf(status, sizeof status, "%s %.1f fps", toString(r.state), secs > 0 ? (i + 1) / secs : 0.0);
+      bar.update(i + 1, status);
+    }
+  } catch (...) {
+    failure = std::current_exception();  // outputs computed so far are still written below
+  }
+  bar.finish();
+  slam.shutdown();
+  if (options.saveMap && !failure) slam.core().saveMap(*options.saveMap);
+  report.relocalisationAttempts = slam.core().relocalisationStats().attempts;
+  report.relocalisations = slam.core().relocalisationStats().successes;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.stats = slam.stats();
+  report.timing = slam.timer().summary();
+
+  fs::create_directories(options.outDir);
+  const Trajectory trajectory = slam.trajectory();
+  const Trajectory keyFrames = slam.keyFrameTrajectory();
+  writeTrajectory(options.outDir / "trajectory.txt", trajectory, TrajectoryFormat::Tum);
+  writeTrajectory(options.outDir / "keyframes.txt", keyFrames, TrajectoryFormat::Tum);
+  auto cloud = slam.mapPointCloud();
+  writePly(options.outDir / "map.ply", cloud);
+
+  OverviewScene scene;
+  scene.estimate = trajectory;
+  scene.keyFrames = keyFrames;
+  scene.mapPoints = cloud;
+  const Trajectory& gt = dataset.groundTruth();
+  if (!gt.empty() && !trajectory.empty()) {
+    try {
+      const eval::AteResult ate = eval::computeAte(gt, trajectory, {eval::Alignment::SE3, 0.02});
+      report.ateRmse = ate.stats.rmse;
+      report.ateMatched = ate.stats.count;
+      for (std::size_t k = 1; k < ate.pairs.size(); ++k)
+        report.pathLength += (gt[ate.pairs[k].groundTruth].pose.translation() -
+                              gt[ate.pairs[k - 1].groundTruth].pose.translation()).norm();
+      // Draw everything in the ground truth's frame.
+      const Sim3d S = ate.alignment;
+      for (auto& s : scene.estimate) s.pose = eval::applySimilarity(S, s.pose);
+      for (auto& s : scene.keyFrames) s.pose = eval::applySimilarity(S, s.pose);
+      for (auto& p : scene.mapPoints) p = (S * p.cast<double>()).cast<float>();
+      // Only the stretch of ground truth the run covers.
+      const double t0 = trajectory.front().t - 0.5, t1 = trajectory.back().t + 0.5;
+      for (const StampedPose& g : gt)
+        if (g.t >= t0 && g.t <= t1) scene.groundTruth.push_back(g);
+    } catch (const Error& e) {
+      report.warnings.push_back(std::string("ATE not computed: ") + e.what());
+    }
+  }
+  char title[200];
+  std::snprintf(title, sizeof title, "%s (%s): %zu/%zu frames tracked, %zu keyframes, %zu points%s", report.dataset.c_str(),
+                report.sensor.c_str(), report.stats.tracked, report.stats.frames, report.stats.keyFrames,
+                report.stats.mapPoints,
+                report.ateRmse ? (", ATE " + std::to_string(*report.ateRmse * 1000).substr(0, 6) + " mm").c_str() : "");
+  scene.title = title;
+  writeOverview(options.outDir / "overview.png", scene);
+  writeReport(options.outDir / "report.json", report);
+  if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace
+
+RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
+  RunReport report;
+  report.dataset = std::string(toString(dataset.kind())) + ":" + dataset.root().filename().string();
+  const Defaults defaults = datasetDefaults(dataset.kind());
+  OrbParams orb;
+  orb.features = defaults.features;
+  double fps = defaults.fps;
+  DatasetCamera camera;
+  if (options.settings) {
+    const Settings s = Settings::load(*options.settings, dataset.sensor());
+    orb = s.orb;
+    fps = s.fps;
+    camera = std::visit([](const auto& c) -> DatasetCamera { return c; }, s.camera);
+  } else {
+    camera = dataset.camera();
+  }
+  report.sensor = std::string(toString(dataset.sensor()));
+  std::visit(
+      [&](const auto& cam) {
+        using C = std::decay_t<decltype(cam)>;
+        if constexpr (std::is_same_v<C, RectifiedStereoCamera<double>>) {
+          runWith<Stereo>(cam, orb, fps, dataset, options, report);
+        } else if constexpr (std::is_same_v<C, RgbdCamera<double>>) {
+          runWith<Rgbd>(cam, orb, fps, dataset, options, report);
+        } else {
+          throw Error("orbis run", "", "monocular SLAM is not available yet: run a stereo or RGB-D sequence");
+        }
+      },
+      camera);
+  return report;
+}
+
+}  // namespace orbis
