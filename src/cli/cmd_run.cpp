@@ -22,7 +22,7 @@ int runCommand(const std::vector<std::string>& args) {
       .option("--out", "DIR", "output folder", "out")
       .option("--sensor", "KIND", "read the dataset as mono, stereo or rgbd (default: its own sensor)")
       .option("--max-frames", "N", "process at most N frames (0: all)", "0")
-      .option("--dense", "FILE", "RGB-D: write a dense cloud back-projected from the keyframes' depth maps")
+      .option("--dense", "FILE", "RGB-D: write a dense coloured cloud (PLY, 1 cm voxels) back-projected from the final keyframes' depth maps")
       .flag("--deterministic", "run the stages inline in a fixed order: identical input gives an identical trajectory")
       .flag("--localize", "localisation only: track against the map without mapping")
       .option("--load-map", "FILE", "start from a saved map (same sensor, camera and vocabulary) and relocalise in it")
@@ -60,6 +60,8 @@ int runCommand(const std::vector<std::string>& args) {
   if (options.loadMap || r.relocalisationAttempts)
     std::printf("relocalised    %zu of %zu attempts; %zu keyframes loaded\n", r.relocalisations,
                 r.relocalisationAttempts, r.keyFramesLoaded);
+  if (options.denseCloud && r.densePoints)
+    std::printf("dense cloud    %zu points in %s\n", r.densePoints, options.denseCloud->string().c_str());
   if (r.ateRmse)
     std::printf("ATE (SE3)      %.4f m RMSE over %zu poses (path %.2f m, %.2f%%)\n", *r.ateRmse, r.ateMatched,
                 r.pathLength, r.pathLength > 0 ? 100 * *r.ateRmse / r.pathLength : 0.0);

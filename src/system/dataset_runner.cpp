@@ -3,8 +3,10 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <map>
 
 #include "orbis/eval/metrics.hpp"
+#include "orbis/io/dense_cloud.hpp"
 #include "orbis/io/overview.hpp"
 #include "orbis/io/ply.hpp"
 #include "orbis/io/settings.hpp"
@@ -26,7 +28,7 @@ namespace fs = std::filesystem;
 fs::path defaultVocabularyPath() {
   const char* name = "vocabulary/orbis_orb_k10_L5.bin";
   if (const char* env = std::getenv("ORBIS_VOCABULARY"); env && *env) return env;
-  for (const fs::path base : {fs::path(ORBIS_SOURCE_DIR_FOR_DATA), fs::path(ORBIS_INSTALL_DATADIR) / "orbis"}) {
+  for (const fs::path& base : {fs::path(ORBIS_SOURCE_DIR_FOR_DATA), fs::path(ORBIS_INSTALL_DATADIR) / "orbis"}) {
     if (base.empty()) continue;
     if (fs::exists(base / name)) return base / name;
   }
@@ -58,6 +60,7 @@ void writeReport(const fs::path& file, const RunReport& r) {
   w.field("keyframes", r.stats.keyFrames).field("map_points", r.stats.mapPoints);
   w.field("seconds", r.seconds);
   w.field("keyframes_loaded", r.keyFramesLoaded);
+  w.field("dense_points", r.densePoints);
   w.field("relocalisation_attempts", r.relocalisationAttempts).field("relocalisations", r.relocalisations);
   w.key("ate");
   if (r.ateRmse) {
@@ -114,6 +117,13 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   ProgressBar bar("orbis run", n, options.progress);
   const auto start = std::chrono::steady_clock::now();
   double lastTimestamp = -std::numeric_limits<double>::infinity();
+  // --dense: the images of every frame that became a keyframe, by timestamp. Depth is kept as
+  // 16-bit at 0.2 mm (the TUM encoding) to halve the memory; the cloud is built at the end,
+  // from the keyframes that survived culling, at their final poses.
+  constexpr double kStoredDepthScale = 5000;
+  std::map<double, std::pair<cv::Mat, cv::Mat>> keyFrameImages;
+  if (options.denseCloud && !Sensor::kDepthFromSensor)
+    report.warnings.push_back("--dense needs an RGB-D sequence: no dense cloud written");
   std::exception_ptr failure;
   try {
     for (std::size_t i = 0; i < n; ++i) {
@@ -137,6 +147,14 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
       }
       lastTimestamp = frame.timestamp;
       const TrackResult r = slam.track(input);
+      if constexpr (Sensor::kDepthFromSensor) {
+        if (options.denseCloud && r.newKeyFrame) {
+          cv::Mat depth;
+          const double toStored = input.depth.depth() == CV_32F ? kStoredDepthScale : kStoredDepthScale / camera.depthScale;
+          input.depth.convertTo(depth, CV_16U, toStored);
+          keyFrameImages[frame.timestamp] = {depth, input.image.clone()};
+        }
+      }
       const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       char status[64];
       std::snprintf(status, sizeof status, "%s %.1f fps", toString(r.state), secs > 0 ? (i + 1) / secs : 0.0);
@@ -195,6 +213,17 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
                 report.ateRmse ? (", ATE " + std::to_string(*report.ateRmse * 1000).substr(0, 6) + " mm").c_str() : "");
   scene.title = title;
   writeOverview(options.outDir / "overview.png", scene);
+  if constexpr (Sensor::kDepthFromSensor) {
+    if (options.denseCloud) {
+      DenseCloudBuilder dense(camera.pinhole, kStoredDepthScale);
+      for (const StampedPose& kf : keyFrames)
+        if (auto it = keyFrameImages.find(kf.t); it != keyFrameImages.end())
+          dense.addView(kf.pose, it->second.first, it->second.second);
+      if (options.denseCloud->has_parent_path()) fs::create_directories(options.denseCloud->parent_path());
+      dense.writePly(*options.denseCloud);
+      report.densePoints = dense.voxelCount();
+    }
+  }
   writeReport(options.outDir / "report.json", report);
   if (failure) std::rethrow_exception(failure);
 }

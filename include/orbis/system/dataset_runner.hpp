@@ -5,8 +5,9 @@
 // Slam<Rgbd>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
 // camera-to-world, every tracked frame), keyframes.txt (TUM), report.json (frame counts,
 // keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE when the dataset
-// has ground truth), map.ply (map points) and overview.png (top view). A frame that cannot be
-// read or tracked is reported and survived; outputs computed so far are still written if a
+// has ground truth), map.ply (map points) and overview.png (top view); for RGB-D, optionally a
+// dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
+// A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
 // later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
 // else from the dataset's own calibration.
 #pragma once
@@ -46,6 +47,7 @@ struct RunReport {
   std::vector<std::string> warnings;
   double seconds = 0;
   std::size_t keyFramesLoaded = 0;  // from RunOptions::loadMap
+  std::size_t densePoints = 0;      // voxels in RunOptions::denseCloud
   std::size_t relocalisationAttempts = 0, relocalisations = 0;
 };
 
