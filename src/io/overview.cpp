@@ -31,7 +31,8 @@ void writeOverview(const std::filesystem::path& file, const OverviewScene& scene
   std::vector<Eigen::Vector3d> fit;
   for (const auto* t : {&scene.estimate, &scene.groundTruth, &scene.keyFrames})
     for (const StampedPose& s : *t) fit.push_back(s.pose.translation());
-  // Map points widen the view to their 2nd–98th percentile box, so stray points do not shrink it.
+  // Map points widen the view to their 10th–90th percentile box: far walls and stray points would
+  // otherwise shrink the place the camera moved through to a corner.
   if (scene.mapPoints.size() >= 10) {
     Eigen::Vector3d plo, phi;
     for (int a = 0; a < 3; ++a) {
@@ -39,8 +40,8 @@ void writeOverview(const std::filesystem::path& file, const OverviewScene& scene
       v.reserve(scene.mapPoints.size());
       for (const auto& p : scene.mapPoints) v.push_back(p[a]);
       std::sort(v.begin(), v.end());
-      plo[a] = v[v.size() * 2 / 100];
-      phi[a] = v[v.size() * 98 / 100];
+      plo[a] = v[v.size() * 10 / 100];
+      phi[a] = v[v.size() * 90 / 100];
     }
     fit.push_back(plo);
     fit.push_back(phi);
