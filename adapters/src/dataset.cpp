@@ -75,7 +75,7 @@ void requireExists(const std::filesystem::path& path, const std::string& what) {
 
 std::vector<ListedImage> readImageList(const std::filesystem::path& listFile,
                                        const std::filesystem::path& imageDir, TimeUnit unit,
-                                       bool requireImages) {
+                                       bool requireImages, std::vector<std::string>* droppedRows) {
   std::vector<ListedImage> images;
   forEachTextRow(listFile, [&](const TextRow& row) {
     if (row.fields.size() != 2)
@@ -85,9 +85,12 @@ std::vector<ListedImage> readImageList(const std::filesystem::path& listFile,
     image.t = unit == TimeUnit::Seconds
                   ? parseDouble(row.fields[0], listFile, row.line)
                   : static_cast<double>(parseInteger(row.fields[0], listFile, row.line)) * 1e-9;
-    if (!images.empty() && !(image.t > images.back().t))
-      throw lineError(listFile.string(), row.line,
-                      "timestamp " + std::string(row.fields[0]) + " is not after the previous row's");
+    if (!images.empty() && !(image.t > images.back().t)) {
+      const std::string what = "timestamp " + std::string(row.fields[0]) + " is not after the previous row's";
+      if (!droppedRows) throw lineError(listFile.string(), row.line, what);
+      droppedRows->push_back(listFile.string() + ", line " + std::to_string(row.line) + ": " + what + "; row skipped");
+      return;
+    }
     image.file = imageDir / std::string(row.fields[1]);
     image.listFile = listFile;
     image.line = row.line;

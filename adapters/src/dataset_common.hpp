@@ -25,9 +25,11 @@ enum class TimeUnit { Seconds, Nanoseconds };
 
 // Reads the list, checks every row (two fields, a number, strictly increasing times) and
 // whether each image exists. When requireImages, a missing image throws naming list and line.
+// With droppedRows, a row whose time does not increase is dropped and described there instead
+// of thrown.
 std::vector<ListedImage> readImageList(const std::filesystem::path& listFile,
                                        const std::filesystem::path& imageDir, TimeUnit unit,
-                                       bool requireImages);
+                                       bool requireImages, std::vector<std::string>* droppedRows = nullptr);
 
 // Throws orbis::Error naming the file (and where it was listed, if known) when unreadable.
 cv::Mat loadImage(const std::filesystem::path& file, int imreadFlags,

@@ -30,11 +30,13 @@ class EurocReader final : public DatasetReader {
       throw Error(root.string(), "", "EuRoC has no depth maps (use stereo or mono)");
     const fs::path mav = fs::exists(root / "mav0") ? root / "mav0" : root;
     requireExists(mav / "cam0", "the EuRoC cam0 folder");
-    left_ = readImageList(mav / "cam0" / "data.csv", mav / "cam0" / "data", TimeUnit::Nanoseconds, true);
+    left_ = readImageList(mav / "cam0" / "data.csv", mav / "cam0" / "data", TimeUnit::Nanoseconds,
+                          !options.tolerateBadFrames, options.tolerateBadFrames ? &warnings_ : nullptr);
     leftSensor_ = readEurocCalibration(mav / "cam0" / "sensor.yaml");
     if (sensor_ == SensorKind::Stereo) {
       std::vector<ListedImage> right =
-          readImageList(mav / "cam1" / "data.csv", mav / "cam1" / "data", TimeUnit::Nanoseconds, false);
+          readImageList(mav / "cam1" / "data.csv", mav / "cam1" / "data", TimeUnit::Nanoseconds, false,
+                        options.tolerateBadFrames ? &warnings_ : nullptr);
       right_ = PairedImages(left_, std::move(right), options.maxStereoDt, "cam1 image");
       rightSensor_ = readEurocCalibration(mav / "cam1" / "sensor.yaml");
       if (options.strict) right_.requireAll(left_);

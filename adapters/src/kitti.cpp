@@ -74,7 +74,7 @@ class KittiReader final : public DatasetReader {
       throw fileError((sequenceDir_ / "image_1").string(), "does not exist (stereo needs the right images)");
 
     for (std::size_t i = 0; i < times_.size(); ++i) {
-      if (!fs::exists(imagePath(0, i)))
+      if (!options.tolerateBadFrames && !fs::exists(imagePath(0, i)))
         throw lineError(timesFile.string(), i + 1, "image " + imagePath(0, i).string() + " does not exist");
       if (sensor_ == SensorKind::Stereo && options.strict && !fs::exists(imagePath(1, i)))
         throw lineError(timesFile.string(), i + 1,

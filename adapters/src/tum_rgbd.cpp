@@ -68,11 +68,14 @@ class TumRgbdReader final : public DatasetReader {
       throw Error(root.string(), "", "a TUM RGB-D sequence has no stereo pair (use rgbd or mono)");
     const fs::path rgbList = root / "rgb.txt";
     requireExists(rgbList, "the TUM image list");
-    rgb_ = readImageList(rgbList, root, TimeUnit::Seconds, true);
+    rgb_ = readImageList(rgbList, root, TimeUnit::Seconds, !options.tolerateBadFrames,
+                         options.tolerateBadFrames ? &warnings_ : nullptr);
     if (sensor_ == SensorKind::Rgbd) {
       const fs::path depthList = root / "depth.txt";
       requireExists(depthList, "the TUM depth list");
-      depth_ = PairedImages(rgb_, readImageList(depthList, root, TimeUnit::Seconds, false),
+      depth_ = PairedImages(rgb_,
+                            readImageList(depthList, root, TimeUnit::Seconds, false,
+                                          options.tolerateBadFrames ? &warnings_ : nullptr),
                             options.maxDepthDt, "depth map");
       if (options.strict) depth_.requireAll(rgb_);
     }

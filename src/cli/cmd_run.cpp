@@ -31,6 +31,7 @@ int runCommand(const std::vector<std::string>& args) {
       .flag("--json", "print the report as JSON on standard output");
   if (!p.parse(args)) return 0;
   DatasetOptions datasetOptions;
+  datasetOptions.tolerateBadFrames = true;  // a bad frame is reported and skipped, not the end of the run
   if (auto s = p.getOptional("--sensor")) datasetOptions.sensor = parseSensorKind(*s, "argument --sensor");
   auto dataset = openDataset(parseDatasetKind(p.pos(0), "argument DATASET"), p.pos(1), datasetOptions);
   RunOptions options;

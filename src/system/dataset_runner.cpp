@@ -113,6 +113,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
     report.keyFramesLoaded = slam.core().loadedKeyFrames();
   }
 
+  for (const auto& w : dataset.warnings()) report.warnings.push_back(w);
   const std::size_t n = options.maxFrames ? std::min(options.maxFrames, dataset.size()) : dataset.size();
   ProgressBar bar("orbis run", n, options.progress);
   const auto start = std::chrono::steady_clock::now();

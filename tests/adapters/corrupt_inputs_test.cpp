@@ -104,6 +104,24 @@ TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {
   expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "");
 }
 
+TEST_F(CorruptInputs, TolerantReadingTurnsBadRowsIntoFrameErrorsAndWarnings) {
+  makeTum();
+  // Row 4 repeats row 3's timestamp; row 5 names an image that is not there.
+  writeText("rgb.txt",
+            "# c\n# f\n100.000000 rgb/100.000000.png\n100.000000 rgb/100.100000.png\n"
+            "100.100000 rgb/gone.png\n100.200000 rgb/100.200000.png\n");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 4");
+  orbis::DatasetOptions tolerant;
+  tolerant.tolerateBadFrames = true;
+  const auto reader = orbis::openTumRgbd(root_, tolerant);
+  ASSERT_EQ(reader->size(), 3u);
+  ASSERT_EQ(reader->warnings().size(), 1u);
+  EXPECT_NE(reader->warnings()[0].find("rgb.txt, line 4"), std::string::npos) << reader->warnings()[0];
+  EXPECT_NO_THROW(reader->frame(0));
+  expectError([&] { reader->frame(1); }, "rgb.txt", "line 5");
+  EXPECT_NO_THROW(reader->frame(2));
+}
+
 TEST_F(CorruptInputs, TumGroundTruthErrorsNameTheLine) {
   makeTum();
   writeText("groundtruth.txt", "# gt\n100.0 0 0 0 0 0 0 1\n100.1 0 0 1 0 0 1\n");

@@ -50,6 +50,10 @@ struct DatasetOptions {
   double tumVirtualBaseline = 0.08;  // TUM: metres (the paper's 8 cm for Kinect-type sensors)
   bool rectify = true;        // EuRoC: deliver rectified images and calibration (what the pipeline eats)
   bool strict = false;        // a missing right image or depth map throws instead of warning
+  // A long run should survive a bad frame: a listed left/colour image that does not exist is then
+  // an error of that frame only (frame(i) throws, naming list file and line), and a list row whose
+  // timestamp does not increase is dropped with a warning (DatasetReader::warnings()).
+  bool tolerateBadFrames = false;
   std::string kittiSequence;  // KITTI: "06" when root holds several sequences
 };
 
@@ -82,6 +86,8 @@ class DatasetReader {
   // or undistorted already): TUM freiburg1/2 images are distorted.
   virtual RadTanDistortion<double> distortion() const { return {}; }
   virtual const std::filesystem::path& root() const = 0;
+  // What was found wrong, and survived, while opening (DatasetOptions::tolerateBadFrames).
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
   // Sequential reading: the next frame, or nothing past the end.
   std::optional<DatasetFrame> next() {
@@ -89,6 +95,9 @@ class DatasetReader {
     return frame(cursor_++);
   }
   void rewind() { cursor_ = 0; }
+
+ protected:
+  std::vector<std::string> warnings_;
 
  private:
   std::size_t cursor_ = 0;
