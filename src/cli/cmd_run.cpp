@@ -21,6 +21,7 @@ int runCommand(const std::vector<std::string>& args) {
       .option("--vocab", "FILE", "vocabulary (orbis binary); default: the shipped one")
       .option("--out", "DIR", "output folder", "out")
       .option("--sensor", "KIND", "read the dataset as mono, stereo or rgbd (default: its own sensor)")
+      .option("--sequence", "NN", "KITTI: the sequence to run when PATH holds several (sequences/NN)")
       .option("--max-frames", "N", "process at most N frames (0: all)", "0")
       .option("--dense", "FILE", "RGB-D: write a dense coloured cloud (PLY, 1 cm voxels) back-projected from the final keyframes' depth maps")
       .flag("--deterministic", "run the stages inline in a fixed order: identical input gives an identical trajectory")
@@ -32,6 +33,7 @@ int runCommand(const std::vector<std::string>& args) {
   if (!p.parse(args)) return 0;
   DatasetOptions datasetOptions;
   datasetOptions.tolerateBadFrames = true;  // a bad frame is reported and skipped, not the end of the run
+  if (auto s = p.getOptional("--sequence")) datasetOptions.kittiSequence = *s;
   if (auto s = p.getOptional("--sensor")) datasetOptions.sensor = parseSensorKind(*s, "argument --sensor");
   auto dataset = openDataset(parseDatasetKind(p.pos(0), "argument DATASET"), p.pos(1), datasetOptions);
   RunOptions options;

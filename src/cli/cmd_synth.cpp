@@ -37,6 +37,7 @@ int runSynth(const std::vector<std::string>& args) {
   p.positional("OUTDIR", "output directory (created; existing files are overwritten)")
       .option("--layout", "tum|euroc|kitti", "dataset layout: tum = RGB-D, euroc and kitti = stereo", "tum")
       .option("--frames", "N", "number of frames (one loop)", "300")
+      .option("--extra", "N", "frames rendered past the loop's end over known ground (loop closing needs them)", "0")
       .option("--width", "W", "image width in pixels", "640")
       .option("--height", "H", "image height in pixels", "480")
       .option("--fx", "F", "focal length in pixels (fy = fx)", "500")
@@ -58,6 +59,8 @@ int runSynth(const std::vector<std::string>& args) {
     return static_cast<int>(v);
   };
   o.frames = positiveInt("--frames");
+  if (p.getInt("--extra") < 0) throw Error("argument --extra", "", "must be 0 or positive");
+  o.extraFrames = static_cast<int>(p.getInt("--extra"));
   o.width = positiveInt("--width");
   o.height = positiveInt("--height");
   o.fx = p.getDouble("--fx");
@@ -75,7 +78,7 @@ int runSynth(const std::vector<std::string>& args) {
   const bool json = p.has("--json");
 
   synth::SyntheticSequence sequence(o);
-  ProgressBar bar("synth", static_cast<std::size_t>(o.frames), !json);
+  ProgressBar bar("synth", static_cast<std::size_t>(o.frames + o.extraFrames), !json);
   const synth::SynthWriteResult r =
       synth::writeSynthSequence(sequence, layout, p.pos(0), [&](int done) { bar.update(static_cast<std::size_t>(done)); });
   bar.finish();

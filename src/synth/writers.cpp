@@ -168,7 +168,7 @@ SynthWriteResult writeSynthSequence(SyntheticSequence& seq, SynthLayout layout, 
   SynthWriteResult result;
   result.root = outDir;
   makeDirectories(outDir);
-  const int n = seq.size();
+  const int n = seq.totalFrames();
   const bool stereo = layout != SynthLayout::Tum;
   const bool depth = layout == SynthLayout::Tum;
 

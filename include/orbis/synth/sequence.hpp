@@ -28,6 +28,8 @@ namespace orbis::synth {
 
 struct SynthOptions {
   int frames = 300;
+  int extraFrames = 0;  // written past the loop's end: the path repeats, so the camera goes on over
+                        // known ground (loop detection needs a few keyframes there)
   int width = 640, height = 480;
   double fx = 500.0;             // fy = fx; principal point at the image centre
   double baseline = 0.1;         // metres, right camera at +baseline along x
@@ -63,7 +65,8 @@ class SyntheticSequence {
   const SynthOptions& options() const { return options_; }
   const Scene& scene() const { return scene_; }
   PinholeCamera<double> camera() const;
-  int size() const { return options_.frames; }
+  int size() const { return options_.frames; }  // one loop
+  int totalFrames() const { return options_.frames + options_.extraFrames; }  // what writers write
 
   std::int64_t timestampNs(int i) const;
   double timestamp(int i) const { return static_cast<double>(timestampNs(i)) * 1e-9; }
