@@ -85,6 +85,7 @@ class TumRgbdReader final : public DatasetReader {
   }
 
   DatasetKind kind() const override { return DatasetKind::TumRgbd; }
+  double rawDepthScale() const override { return sensor_ == SensorKind::Rgbd ? options_.tumDepthScale : 0.0; }
   SensorKind sensor() const override { return sensor_; }
   std::size_t size() const override { return rgb_.size(); }
   double timestamp(std::size_t index) const override { return rgb_.at(index).t; }

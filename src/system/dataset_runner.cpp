@@ -100,7 +100,7 @@ bool inputComplete(const RgbdInput& in) { return !in.image.empty() && !in.depth.
 
 template <class Sensor>
 void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double fps, DatasetReader& dataset,
-             const RunOptions& options, RunReport& report) {
+             const RunOptions& options, RunReport& report, double depthRescale = 1.0) {
   auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
   SlamOptions slamOptions;
   slamOptions.deterministic = options.deterministic;
@@ -141,7 +141,10 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
                                   std::to_string(frame.timestamp) + " does not increase");
         continue;
       }
-      const auto input = makeInput<Sensor>(frame);
+      auto input = makeInput<Sensor>(frame);
+      if constexpr (Sensor::kDepthFromSensor) {
+        if (depthRescale != 1.0 && !input.depth.empty()) input.depth = input.depth * depthRescale;
+      }
       if (!inputComplete(input)) {
         report.warnings.push_back("frame " + std::to_string(i) + " skipped: incomplete input");
         continue;
@@ -254,7 +257,12 @@ RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
         if constexpr (std::is_same_v<C, RectifiedStereoCamera<double>>) {
           runWith<Stereo>(cam, orb, fps, dataset, options, report);
         } else if constexpr (std::is_same_v<C, RgbdCamera<double>>) {
-          runWith<Rgbd>(cam, orb, fps, dataset, options, report);
+          // The reader delivers metres at its own depth factor; a settings file's DepthMapFactor
+          // (ORB-SLAM2 uses 5208 for freiburg1/2) replaces it.
+          const double rescale = options.settings && dataset.rawDepthScale() > 0 && cam.depthScale > 0
+                                     ? dataset.rawDepthScale() / cam.depthScale
+                                     : 1.0;
+          runWith<Rgbd>(cam, orb, fps, dataset, options, report, rescale);
         } else {
           throw Error("orbis run", "", "monocular SLAM is not available yet: run a stereo or RGB-D sequence");
         }

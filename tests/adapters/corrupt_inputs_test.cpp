@@ -88,6 +88,10 @@ TEST_F(CorruptInputs, IntactTumSequenceReadsCleanly) {
   EXPECT_TRUE(f.warnings.empty());
   EXPECT_FLOAT_EQ(f.depth.at<float>(0, 0), 1.0f);  // 5000 / 5000
   EXPECT_EQ(reader->groundTruth().size(), 2u);
+  EXPECT_EQ(reader->rawDepthScale(), 5000.0);  // what a settings file's DepthMapFactor replaces
+  orbis::DatasetOptions mono;
+  mono.sensor = orbis::SensorKind::Monocular;
+  EXPECT_EQ(orbis::openTumRgbd(root_, mono)->rawDepthScale(), 0.0);
 }
 
 TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {

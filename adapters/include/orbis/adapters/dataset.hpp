@@ -86,6 +86,9 @@ class DatasetReader {
   // or undistorted already): TUM freiburg1/2 images are distorted.
   virtual RadTanDistortion<double> distortion() const { return {}; }
   virtual const std::filesystem::path& root() const = 0;
+  // The factor the reader divided raw depth values by to deliver metres (TUM: tumDepthScale);
+  // 0 when the dataset has no depth. A settings file's DepthMapFactor overrides it through this.
+  virtual double rawDepthScale() const { return 0; }
   // What was found wrong, and survived, while opening (DatasetOptions::tolerateBadFrames).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
