@@ -23,6 +23,29 @@ Tracker::Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMapper* mapper,
                  StageTimer* timer)
     : map_(map), vocabulary_(vocabulary), mapper_(mapper), options_(options), timer_(timer) {}
 
+namespace {
+
+// Keypoints with depth and no map point yet that become points, nearest first: every close one,
+// far ones only while fewer than 100 keypoints (with or without a point) have been passed
+// (ORB-SLAM2's rule, for new keyframes and for localisation mode's visual-odometry points).
+std::vector<std::size_t> keypointsToLift(const Frame& f) {
+  std::vector<std::pair<float, std::size_t>> byDepth;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (f.features->depth[i] > 0) byDepth.emplace_back(f.features->depth[i], i);
+  std::sort(byDepth.begin(), byDepth.end());
+  std::vector<std::size_t> lift;
+  int passed = 0;
+  for (const auto& [z, i] : byDepth) {
+    const MapPoint* existing = f.points[i];
+    if (!existing || existing->observationCount() < 1) lift.push_back(i);
+    ++passed;
+    if (z > f.intrinsics.closeDepth && passed > 100) break;
+  }
+  return lift;
+}
+
+}  // namespace
+
 SE3d Tracker::worldPose(const TrackedFrame& f) {
   // A culled reference keyframe hangs from its parent by the relative pose it had when culled.
   const KeyFrame* kf = f.reference;
@@ -185,26 +208,16 @@ void Tracker::updateLastFrame() {
   if (!options_.localisationOnly || last_.index == lastKeyFrameFrame_ || last_.intrinsics.bf <= 0) return;
   // Localisation mode: temporary points from the last frame's depth, so that tracking survives
   // where the map has no points (paper §III-F).
-  std::vector<std::pair<float, std::size_t>> byDepth;
-  for (std::size_t i = 0; i < last_.size(); ++i)
-    if (last_.features->depth[i] > 0) byDepth.emplace_back(last_.features->depth[i], i);
-  std::sort(byDepth.begin(), byDepth.end());
-  int created = 0;
-  for (const auto& [z, i] : byDepth) {
-    MapPoint* existing = last_.points[i];
-    if (!existing || existing->observationCount() < 1) {
-      Eigen::Vector3d pw;
-      last_.unprojectStereo(i, pw);
-      const MapPointId tempId = std::numeric_limits<MapPointId>::max() - temporaryStorage_.size();
-      temporaryStorage_.push_back(std::make_unique<MapPoint>(tempId, pw, nullptr, 0, last_.index));
-      MapPoint* p = temporaryStorage_.back().get();
-      p->setDescriptor(last_.features->descriptors[i]);
-      last_.points[i] = p;
-      last_.outlier[i] = 0;
-      temporaryPoints_.push_back(p);
-    }
-    ++created;
-    if (z > last_.intrinsics.closeDepth && created > 100) break;
+  for (const std::size_t i : keypointsToLift(last_)) {
+    Eigen::Vector3d pw;
+    last_.unprojectStereo(i, pw);
+    const MapPointId tempId = std::numeric_limits<MapPointId>::max() - temporaryStorage_.size();
+    temporaryStorage_.push_back(std::make_unique<MapPoint>(tempId, pw, nullptr, 0, last_.index));
+    MapPoint* p = temporaryStorage_.back().get();
+    p->setDescriptor(last_.features->descriptors[i]);
+    last_.points[i] = p;
+    last_.outlier[i] = 0;
+    temporaryPoints_.push_back(p);
   }
 }
 
@@ -359,26 +372,16 @@ void Tracker::createNewKeyFrame() {
     if (current_.points[i]) kf->setPoint(i, current_.points[i]);
   // Close stereo points become map points at once (paper §III-A); far ones only while fewer than
   // 100 points were added, nearest first.
-  std::vector<std::pair<float, std::size_t>> byDepth;
-  for (std::size_t i = 0; i < current_.size(); ++i)
-    if (current_.features->depth[i] > 0) byDepth.emplace_back(current_.features->depth[i], i);
-  std::sort(byDepth.begin(), byDepth.end());
-  int points = 0;
-  for (const auto& [z, i] : byDepth) {
-    MapPoint* existing = current_.points[i];
-    if (!existing || existing->observationCount() < 1) {
-      Eigen::Vector3d pw;
-      current_.unprojectStereo(i, pw);
-      MapPoint* p = map_.createMapPoint(pw, kf, current_.index);
-      p->addObservation(kf, i);
-      kf->setPoint(i, p);
-      p->computeDistinctiveDescriptor();
-      p->updateNormalAndDepth();
-      current_.points[i] = p;
-      current_.outlier[i] = 0;
-    }
-    ++points;
-    if (z > current_.intrinsics.closeDepth && points > 100) break;
+  for (const std::size_t i : keypointsToLift(current_)) {
+    Eigen::Vector3d pw;
+    current_.unprojectStereo(i, pw);
+    MapPoint* p = map_.createMapPoint(pw, kf, current_.index);
+    p->addObservation(kf, i);
+    kf->setPoint(i, p);
+    p->computeDistinctiveDescriptor();
+    p->updateNormalAndDepth();
+    current_.points[i] = p;
+    current_.outlier[i] = 0;
   }
   lastKeyFrame_ = kf;
   lastKeyFrameFrame_ = current_.index;
