@@ -153,6 +153,26 @@ TEST(SynthWriters, LayoutNamesRoundTripAndBadNamesAreErrors) {
   EXPECT_THROW(parseSynthLayout("bag"), Error);
 }
 
+TEST(SynthWriters, ExtraFramesContinueThePeriodicPathPastTheLoop) {
+  SynthOptions o = tinyOptions();
+  o.blackCount = 0;
+  o.extraFrames = 3;
+  SyntheticSequence seq(o);
+  const fs::path dir = freshDir("extra");
+  const SynthWriteResult written = writeSynthSequence(seq, SynthLayout::Tum, dir);
+  EXPECT_EQ(written.frames, o.frames + o.extraFrames);
+  auto reader = openTumRgbd(dir, {});
+  ASSERT_EQ(reader->size(), static_cast<std::size_t>(o.frames + o.extraFrames));
+  const Trajectory& gt = reader->groundTruth();
+  ASSERT_EQ(gt.size(), reader->size());
+  // Frame frames + k is taken where frame k was: the path repeats, time goes on.
+  for (int k = 0; k < o.extraFrames; ++k) {
+    EXPECT_LT(poseDistance(gt[static_cast<std::size_t>(k)].pose, gt[static_cast<std::size_t>(o.frames + k)].pose), 1e-6);
+    EXPECT_GT(gt[static_cast<std::size_t>(o.frames + k)].t, gt[static_cast<std::size_t>(o.frames + k - 1)].t);
+  }
+  fs::remove_all(dir);
+}
+
 TEST(SynthWriters, UnwritableDirectoryNamesThePath) {
   SyntheticSequence seq(tinyOptions());
   const fs::path blocker = freshDir("blocker");
