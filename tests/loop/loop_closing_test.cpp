@@ -10,28 +10,13 @@
 #include "orbis/util/error.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/system/slam.hpp"
+#include "slam_test_util.hpp"
 #include "test_data.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace orbis;
-
-// The shipped vocabulary; while its file name is in flux, any vocabulary the source tree ships.
-fs::path vocabularyPath() {
-  try {
-    return defaultVocabularyPath();
-  } catch (const Error&) {
-    for (const auto& entry : fs::directory_iterator(test::sourceDir() / "vocabulary"))
-      if (entry.path().extension() == ".bin") return entry.path();
-    throw;
-  }
-}
-
-std::shared_ptr<const OrbVocabulary> vocabulary() {
-  static auto voc = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(vocabularyPath()));
-  return voc;
-}
 
 // One loop around the room at low resolution with image noise: enough drift for the loop to
 // matter, small enough to render and track in seconds.
@@ -57,10 +42,7 @@ struct LoopRun {
 template <class Sensor>
 LoopRun runLoop(const synth::SynthOptions& options, bool loopClosing, bool deterministic) {
   synth::SyntheticSequence seq(options);
-  const PinholeCamera<double> pinhole = seq.camera();
-  typename Sensor::Camera camera;
-  if constexpr (std::is_same_v<Sensor, Rgbd>) camera = RgbdCamera<double>(pinhole, options.baseline, 1.0);
-  else camera = RectifiedStereoCamera<double>(pinhole, options.baseline);
+  const auto camera = test::syntheticCamera<Sensor>(seq, options.baseline);
   OrbParams orb;
   orb.features = 800;
   SlamOptions slamOptions;
@@ -68,7 +50,7 @@ LoopRun runLoop(const synth::SynthOptions& options, bool loopClosing, bool deter
   slamOptions.loopClosing = loopClosing;
   slamOptions.fps = options.fps;
   slamOptions.seed = 11;
-  Slam<Sensor> slam(camera, orb, vocabulary(), slamOptions);
+  Slam<Sensor> slam(camera, orb, test::sharedVocabulary(), slamOptions);
   LoopRun run;
   // One loop and a quarter: the camera comes back to its start and keeps going over known ground,
   // as loop detection needs a few consecutive keyframes there (the renderer's path is periodic).
@@ -76,8 +58,7 @@ LoopRun runLoop(const synth::SynthOptions& options, bool loopClosing, bool deter
   for (int i = 0; i < frames; ++i) {
     synth::SynthFrame f = seq.render(i, !Sensor::kDepthFromSensor, Sensor::kDepthFromSensor);
     run.groundTruth.push_back({seq.timestamp(i), f.pose});
-    if constexpr (std::is_same_v<Sensor, Rgbd>) slam.track(RgbdInput{seq.timestamp(i), f.left, f.depth});
-    else slam.track(StereoInput{seq.timestamp(i), f.left, f.right});
+    slam.track(test::syntheticInput<Sensor>(f, seq.timestamp(i)));
   }
   slam.shutdown();
   run.estimate = slam.trajectory();
@@ -147,7 +128,7 @@ TEST(LoopClosing, ThreadedRunClosesTheLoop) {
 
 RunReport runReal(DatasetReader& dataset, const fs::path& out, bool loopClosing) {
   RunOptions options;
-  options.vocabulary = vocabularyPath();
+  options.vocabulary = defaultVocabularyPath();
   options.outDir = out;
   options.deterministic = true;
   options.progress = false;

@@ -15,16 +15,12 @@
 #include "orbis/synth/sequence.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/system/slam.hpp"
+#include "slam_test_util.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace orbis;
-
-std::shared_ptr<const OrbVocabulary> vocabulary() {
-  static auto voc = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(defaultVocabularyPath()));
-  return voc;
-}
 
 constexpr int kFrames = 150;
 
@@ -71,9 +67,7 @@ template <class Sensor>
 RunResult run(const RunSpec& spec) {
   const synth::SynthOptions options = loopOptions();
   synth::SyntheticSequence seq(options);
-  typename Sensor::Camera camera;
-  if constexpr (std::is_same_v<Sensor, Rgbd>) camera = RgbdCamera<double>(seq.camera(), options.baseline, 1.0);
-  else camera = RectifiedStereoCamera<double>(seq.camera(), options.baseline);
+  const auto camera = test::syntheticCamera<Sensor>(seq, options.baseline);
   OrbParams orb;
   orb.features = 1000;
   SlamOptions slamOptions;
@@ -81,7 +75,7 @@ RunResult run(const RunSpec& spec) {
   slamOptions.loopClosing = false;  // the loop of this path would hide the effect under test
   slamOptions.localisationOnly = spec.localisationOnly;
   slamOptions.fps = options.fps;
-  Slam<Sensor> slam(camera, orb, vocabulary(), slamOptions);
+  Slam<Sensor> slam(camera, orb, test::sharedVocabulary(), slamOptions);
   RunResult r;
   if (spec.loadMap) {
     slam.core().loadMap(*spec.loadMap);
@@ -98,10 +92,7 @@ RunResult run(const RunSpec& spec) {
       f.right = black(f.right);
       f.depth = black(f.depth);
     }
-    TrackResult result;
-    if constexpr (std::is_same_v<Sensor, Rgbd>) result = slam.track(RgbdInput{t, f.left, f.depth});
-    else result = slam.track(StereoInput{t, f.left, f.right});
-    r.states.push_back(result.state);
+    r.states.push_back(slam.track(test::syntheticInput<Sensor>(f, t)).state);
   }
   slam.shutdown();
   if (spec.saveMap) slam.core().saveMap(*spec.saveMap);
@@ -178,13 +169,13 @@ TEST(MapReuse, MapOfAnotherSensorIsRefused) {
   const fs::path file = tempFile("stereo_only.map");
   {
     synth::SyntheticSequence seq(loopOptions());
-    Slam<Stereo> stereo(RectifiedStereoCamera<double>(seq.camera(), loopOptions().baseline), OrbParams{}, vocabulary(),
+    Slam<Stereo> stereo(RectifiedStereoCamera<double>(seq.camera(), loopOptions().baseline), OrbParams{}, test::sharedVocabulary(),
                         {.deterministic = true, .loopClosing = false});
     stereo.shutdown();
     stereo.core().saveMap(file);
   }
   synth::SyntheticSequence seq(loopOptions());
-  Slam<Rgbd> rgbd(RgbdCamera<double>(seq.camera(), loopOptions().baseline, 1.0), OrbParams{}, vocabulary(),
+  Slam<Rgbd> rgbd(RgbdCamera<double>(seq.camera(), loopOptions().baseline, 1.0), OrbParams{}, test::sharedVocabulary(),
                   {.deterministic = true});
   try {
     rgbd.core().loadMap(file);

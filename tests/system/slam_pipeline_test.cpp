@@ -10,17 +10,13 @@
 #include "orbis/synth/sequence.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/system/slam.hpp"
+#include "slam_test_util.hpp"
 #include "test_data.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace orbis;
-
-std::shared_ptr<const OrbVocabulary> vocabulary() {
-  static auto voc = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(defaultVocabularyPath()));
-  return voc;
-}
 
 synth::SynthOptions smallLoop(std::uint64_t seed) {
   synth::SynthOptions o;
@@ -39,17 +35,14 @@ struct SyntheticRun {
 template <class Sensor>
 SyntheticRun runSynthetic(const synth::SynthOptions& options, const std::vector<int>& corrupt = {}) {
   synth::SyntheticSequence seq(options);
-  const PinholeCamera<double> pinhole = seq.camera();
-  typename Sensor::Camera camera;
-  if constexpr (std::is_same_v<Sensor, Rgbd>) camera = RgbdCamera<double>(pinhole, options.baseline, 1.0);
-  else camera = RectifiedStereoCamera<double>(pinhole, options.baseline);
+  const auto camera = test::syntheticCamera<Sensor>(seq, options.baseline);
   OrbParams orb;
   orb.features = 1000;
   SlamOptions slamOptions;
   slamOptions.deterministic = true;
   slamOptions.loopClosing = false;
   slamOptions.fps = options.fps;
-  Slam<Sensor> slam(camera, orb, vocabulary(), slamOptions);
+  Slam<Sensor> slam(camera, orb, test::sharedVocabulary(), slamOptions);
   SyntheticRun run;
   for (int i = 0; i < seq.size(); ++i) {
     synth::SynthFrame f = seq.render(i, !Sensor::kDepthFromSensor, Sensor::kDepthFromSensor);
@@ -60,8 +53,7 @@ SyntheticRun runSynthetic(const synth::SynthOptions& options, const std::vector<
       if (!f.right.empty()) f.right.setTo(0);
       if (!f.depth.empty()) f.depth.setTo(0);
     }
-    if constexpr (std::is_same_v<Sensor, Rgbd>) slam.track(RgbdInput{seq.timestamp(i), f.left, f.depth});
-    else slam.track(StereoInput{seq.timestamp(i), f.left, f.right});
+    slam.track(test::syntheticInput<Sensor>(f, seq.timestamp(i)));
   }
   slam.shutdown();
   run.estimate = slam.trajectory();
