@@ -85,7 +85,6 @@ class TumRgbdReader final : public DatasetReader {
   }
 
   DatasetKind kind() const override { return DatasetKind::TumRgbd; }
-  double rawDepthScale() const override { return sensor_ == SensorKind::Rgbd ? options_.tumDepthScale : 0.0; }
   SensorKind sensor() const override { return sensor_; }
   std::size_t size() const override { return rgb_.size(); }
   double timestamp(std::size_t index) const override { return rgb_.at(index).t; }
@@ -99,8 +98,8 @@ class TumRgbdReader final : public DatasetReader {
                   "cannot tell which TUM Kinect (freiburg1/2/3) recorded this "
                   "sequence; give the calibration in a settings file");
     if (sensor_ == SensorKind::Monocular) return *pinhole;
-    // Frames carry depth in metres already, hence a depth scale of 1.
-    return RgbdCamera<double>(*pinhole, options_.tumVirtualBaseline, 1.0);
+    // Frames carry the raw 16-bit depth; the camera says how it becomes metres.
+    return RgbdCamera<double>(*pinhole, options_.tumVirtualBaseline, options_.tumDepthScale);
   }
 
   RadTanDistortion<double> distortion() const override {
@@ -118,11 +117,10 @@ class TumRgbdReader final : public DatasetReader {
     const ListedImage* depth =
         sensor_ == SensorKind::Rgbd ? depth_.find(rgb_, index, frame.warnings, false) : nullptr;
     if (depth) {
-      const cv::Mat raw = loadImage(*depth, cv::IMREAD_UNCHANGED);
-      if (raw.type() != CV_16UC1)
+      frame.depth = loadImage(*depth, cv::IMREAD_UNCHANGED);
+      if (frame.depth.type() != CV_16UC1)
         throw lineError(depth->listFile.string(), depth->line,
                         "depth image " + depth->file.string() + " is not 16-bit single-channel");
-      raw.convertTo(frame.depth, CV_32F, 1.0 / options_.tumDepthScale);
     }
     return frame;
   }

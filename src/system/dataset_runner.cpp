@@ -100,7 +100,7 @@ bool inputComplete(const RgbdInput& in) { return !in.image.empty() && !in.depth.
 
 template <class Sensor>
 void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double fps, DatasetReader& dataset,
-             const RunOptions& options, RunReport& report, double depthRescale = 1.0) {
+             const RunOptions& options, RunReport& report) {
   auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
   SlamOptions slamOptions;
   slamOptions.deterministic = options.deterministic;
@@ -118,10 +118,9 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   ProgressBar bar("orbis run", n, options.progress);
   const auto start = std::chrono::steady_clock::now();
   double lastTimestamp = -std::numeric_limits<double>::infinity();
-  // --dense: the images of every frame that became a keyframe, by timestamp. Depth is kept as
-  // 16-bit at 0.2 mm (the TUM encoding) to halve the memory; the cloud is built at the end,
+  // --dense: the images of every frame that became a keyframe, by timestamp (the reader loads
+  // fresh ones each frame, so keeping a reference is enough); the cloud is built at the end,
   // from the keyframes that survived culling, at their final poses.
-  constexpr double kStoredDepthScale = 5000;
   std::map<double, std::pair<cv::Mat, cv::Mat>> keyFrameImages;
   if (options.denseCloud && !Sensor::kDepthFromSensor)
     report.warnings.push_back("--dense needs an RGB-D sequence: no dense cloud written");
@@ -141,10 +140,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
                                   std::to_string(frame.timestamp) + " does not increase");
         continue;
       }
-      auto input = makeInput<Sensor>(frame);
-      if constexpr (Sensor::kDepthFromSensor) {
-        if (depthRescale != 1.0 && !input.depth.empty()) input.depth = input.depth * depthRescale;
-      }
+      const auto input = makeInput<Sensor>(frame);
       if (!inputComplete(input)) {
         report.warnings.push_back("frame " + std::to_string(i) + " skipped: incomplete input");
         continue;
@@ -152,12 +148,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
       lastTimestamp = frame.timestamp;
       const TrackResult r = slam.track(input);
       if constexpr (Sensor::kDepthFromSensor) {
-        if (options.denseCloud && r.newKeyFrame) {
-          cv::Mat depth;
-          const double toStored = input.depth.depth() == CV_32F ? kStoredDepthScale : kStoredDepthScale / camera.depthScale;
-          input.depth.convertTo(depth, CV_16U, toStored);
-          keyFrameImages[frame.timestamp] = {depth, input.image.clone()};
-        }
+        if (options.denseCloud && r.newKeyFrame) keyFrameImages[frame.timestamp] = {input.depth, input.image};
       }
       const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       char status[64];
@@ -170,8 +161,9 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   bar.finish();
   slam.shutdown();
   if (options.saveMap && !failure) slam.core().saveMap(*options.saveMap);
-  report.relocalisationAttempts = slam.core().relocalisationStats().attempts;
-  report.relocalisations = slam.core().relocalisationStats().successes;
+  const RelocalisationStats relocalisation = slam.core().relocalisationStats();
+  report.relocalisationAttempts = relocalisation.attempts;
+  report.relocalisations = relocalisation.successes;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.stats = slam.stats();
   report.timing = slam.timer().summary();
@@ -219,7 +211,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   writeOverview(options.outDir / "overview.png", scene);
   if constexpr (Sensor::kDepthFromSensor) {
     if (options.denseCloud) {
-      DenseCloudBuilder dense(camera.pinhole, kStoredDepthScale);
+      DenseCloudBuilder dense(camera.pinhole, camera.depthScale);
       for (const StampedPose& kf : keyFrames)
         if (auto it = keyFrameImages.find(kf.t); it != keyFrameImages.end())
           dense.addView(kf.pose, it->second.first, it->second.second);
@@ -257,12 +249,7 @@ RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
         if constexpr (std::is_same_v<C, RectifiedStereoCamera<double>>) {
           runWith<Stereo>(cam, orb, fps, dataset, options, report);
         } else if constexpr (std::is_same_v<C, RgbdCamera<double>>) {
-          // The reader delivers metres at its own depth factor; a settings file's DepthMapFactor
-          // (ORB-SLAM2 uses 5208 for freiburg1/2) replaces it.
-          const double rescale = options.settings && dataset.rawDepthScale() > 0 && cam.depthScale > 0
-                                     ? dataset.rawDepthScale() / cam.depthScale
-                                     : 1.0;
-          runWith<Rgbd>(cam, orb, fps, dataset, options, report, rescale);
+          runWith<Rgbd>(cam, orb, fps, dataset, options, report);
         } else {
           throw Error("orbis run", "", "monocular SLAM is not available yet: run a stereo or RGB-D sequence");
         }

@@ -86,12 +86,10 @@ TEST_F(CorruptInputs, IntactTumSequenceReadsCleanly) {
   ASSERT_EQ(reader->size(), 3u);
   const auto f = reader->frame(2);
   EXPECT_TRUE(f.warnings.empty());
-  EXPECT_FLOAT_EQ(f.depth.at<float>(0, 0), 1.0f);  // 5000 / 5000
+  ASSERT_EQ(f.depth.type(), CV_16UC1);  // raw, as stored; the camera converts
+  EXPECT_EQ(f.depth.at<std::uint16_t>(0, 0), 5000);
+  EXPECT_EQ(std::get<orbis::RgbdCamera<double>>(reader->camera()).metricDepth(5000.0), 1.0);
   EXPECT_EQ(reader->groundTruth().size(), 2u);
-  EXPECT_EQ(reader->rawDepthScale(), 5000.0);  // what a settings file's DepthMapFactor replaces
-  orbis::DatasetOptions mono;
-  mono.sensor = orbis::SensorKind::Monocular;
-  EXPECT_EQ(orbis::openTumRgbd(root_, mono)->rawDepthScale(), 0.0);
 }
 
 TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {

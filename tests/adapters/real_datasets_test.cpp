@@ -30,7 +30,7 @@ ReadSummary readAll(orbis::DatasetReader& reader, int expectedLeftType) {
     }
     if (!frame->depth.empty()) {
       ++s.withDepth;
-      EXPECT_EQ(frame->depth.type(), CV_32FC1);
+      EXPECT_EQ(frame->depth.type(), CV_16UC1);
       EXPECT_EQ(frame->depth.size(), frame->left.size());
     }
     s.warnings += frame->warnings.size();
@@ -72,10 +72,11 @@ TEST(RealDatasets, TumTeddyAllFramesWithDepth) {
   EXPECT_DOUBLE_EQ(camera.pinhole.fx, 535.4);
   EXPECT_NEAR(camera.bf(), 535.4 * 0.08, 1e-9);
 
-  // Depth in metres: the Kinect sees the teddy scene between ~0.5 and ~5 m.
+  // Raw depth through the camera's factor: the Kinect sees the teddy scene between ~0.5 and ~5 m.
   const orbis::DatasetFrame f = reader->frame(100);
   double minDepth = 0, maxDepth = 0;
   cv::minMaxLoc(f.depth, &minDepth, &maxDepth);
+  maxDepth = camera.metricDepth(maxDepth);
   EXPECT_EQ(minDepth, 0.0);  // holes stay 0
   EXPECT_GT(maxDepth, 1.0);
   EXPECT_LT(maxDepth, 10.0);

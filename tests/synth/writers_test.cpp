@@ -96,9 +96,11 @@ TEST_P(SynthLayoutTest, AdaptersReadBackFramesGroundTruthAndCalibration) {
     EXPECT_NEAR(d.timestamp, dt, 2e-6) << "frame " << i;
     expectSameImage(f.left, d.left, "left " + std::to_string(i));
     if (layout == SynthLayout::Tum) {
-      ASSERT_EQ(d.depth.type(), CV_32FC1);
+      ASSERT_EQ(d.depth.type(), CV_16UC1);
       // 16-bit PNG at 5000 per metre: a quantisation step of 0.2 mm.
-      EXPECT_LE(cv::norm(f.depth, d.depth, cv::NORM_INF), 1.0 / 5000.0 * 0.5 + 1e-6) << "depth " << i;
+      cv::Mat metres;
+      d.depth.convertTo(metres, CV_32F, 1.0 / 5000.0);
+      EXPECT_LE(cv::norm(f.depth, metres, cv::NORM_INF), 1.0 / 5000.0 * 0.5 + 1e-6) << "depth " << i;
     } else {
       expectSameImage(f.right, d.right, "right " + std::to_string(i));
     }

@@ -8,13 +8,12 @@
 // kind(i) is Monocular without depth, Close when depth < closeDepth (camera's threshold, 40
 // baselines by default), else Far. The grid indexes keypointsUn over the undistorted image
 // bounds (the undistorted image corners for a distorting lens, the image rectangle otherwise).
-// Builders: extractMonocular, extractStereo (rectified pair; the two extractions run on
-// OpenCV's thread pool), extractRgbd (depth image CV_16U or CV_32F, raw value / depthScale =
+// Builders: extractMonocular, extractStereo (rectified pair; the right image is extracted on a
+// second thread), extractRgbd (depth image CV_16U or CV_32F, raw value / depthScale =
 // metres; 0, negative or NaN means no depth). Errors of input type throw orbis::Error.
 #pragma once
 
 #include <future>
-
 #include <limits>
 #include <span>
 #include <vector>

@@ -46,7 +46,7 @@ struct DatasetOptions {
   std::optional<SensorKind> sensor;
   double maxDepthDt = 0.02;          // TUM: largest |t_rgb - t_depth| of an associated pair, seconds
   double maxStereoDt = 0.003;        // EuRoC: largest |t_cam0 - t_cam1| of a stereo pair, seconds
-  double tumDepthScale = 5000.0;     // TUM: raw depth value / scale = metres
+  double tumDepthScale = 5000.0;     // TUM: raw depth value / scale = metres (the camera's depthScale)
   double tumVirtualBaseline = 0.08;  // TUM: metres (the paper's 8 cm for Kinect-type sensors)
   bool rectify = true;        // EuRoC: deliver rectified images and calibration (what the pipeline eats)
   bool strict = false;        // a missing right image or depth map throws instead of warning
@@ -62,7 +62,8 @@ struct DatasetFrame {
   double timestamp = 0.0;  // seconds
   cv::Mat left;            // 8-bit, grey or BGR as stored (the colour image for RGB-D)
   cv::Mat right;           // stereo only; empty when missing (see warnings)
-  cv::Mat depth;           // RGB-D only: CV_32F metres, 0 = no reading; empty when missing
+  cv::Mat depth;           // RGB-D only: raw CV_16U as stored (metres = value / the camera's
+                           // depthScale), 0 = no reading; empty when missing
   std::vector<std::string> warnings;
 };
 
@@ -86,9 +87,6 @@ class DatasetReader {
   // or undistorted already): TUM freiburg1/2 images are distorted.
   virtual RadTanDistortion<double> distortion() const { return {}; }
   virtual const std::filesystem::path& root() const = 0;
-  // The factor the reader divided raw depth values by to deliver metres (TUM: tumDepthScale);
-  // 0 when the dataset has no depth. A settings file's DepthMapFactor overrides it through this.
-  virtual double rawDepthScale() const { return 0; }
   // What was found wrong, and survived, while opening (DatasetOptions::tolerateBadFrames).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
