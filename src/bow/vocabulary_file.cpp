@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "orbis/util/atomic_file.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis::bow {
@@ -257,17 +258,7 @@ VocabularyBlob VocabularyBlob::build(const VocabularyInfo& info, const std::byte
 
 void VocabularyBlob::save(const std::filesystem::path& path) const {
   if (!valid()) throw fileError(path.string(), "no vocabulary to save");
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw fileError(tmp.string(), "cannot open for writing");
-    out.write(reinterpret_cast<const char*>(data_.get()), static_cast<std::streamsize>(size_));
-    out.flush();
-    if (!out) throw fileError(tmp.string(), "write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw fileError(path.string(), "cannot move the written file into place: " + ec.message());
+  writeFileAtomically(path, {reinterpret_cast<const char*>(data_.get()), size_});
 }
 
 }  // namespace orbis::bow

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "orbis/bow/vocabulary_file.hpp"
+#include "orbis/util/atomic_file.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis {
@@ -228,11 +229,8 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
     for (std::size_t g = 0; g < fv.size(); ++g)
       for (std::uint32_t feature : fv.featuresOf(g)) groups.push_back({fv.node(g), feature});
     w.putArray(groups);
-    // The tree re-parents children of culled keyframes; should one still hang from a culled
-    // keyframe, its nearest good ancestor stands in (bounded walk: a damaged tree must not hang).
+    // Culling re-parents the children of a culled keyframe, so a good keyframe's parent is good.
     const KeyFrame* parent = kf->parent();
-    for (int step = 0; parent && parent->isBad() && step < 1000; ++step) parent = parent->parent();
-    if (parent && (parent->isBad() || parent == kf)) parent = nullptr;
     w.put<std::int64_t>(parent ? static_cast<std::int64_t>(parent->id) : -1);
     std::vector<std::uint64_t> loops;
     for (const KeyFrame* l : kf->loopEdges())
@@ -265,16 +263,7 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
   const std::uint64_t checksum = bow::checksum64(bytes.data(), bytes.size());
   w.put(checksum);
 
-  const fs::path temporary = file.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw fileError(temporary.string(), "cannot open for writing");
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw fileError(temporary.string(), "write failed");
-  }
-  std::error_code ec;
-  fs::rename(temporary, file, ec);
-  if (ec) throw fileError(file.string(), "cannot move the written map into place: " + ec.message());
+  writeFileAtomically(file, w.bytes());
 }
 
 MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expected) {

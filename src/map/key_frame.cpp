@@ -136,6 +136,9 @@ void KeyFrame::changeParent(KeyFrame* parent) {
   if (parent_) parent_->eraseChild(this);
   parent_ = parent;
   parent->addChild(this);
+  // A keyframe with a parent is in the tree: its next updateConnections() must not re-parent it
+  // behind the old parent's back (keyframes restored from a map file come through here).
+  firstConnection_ = false;
 }
 
 bool KeyFrame::setBad() {
