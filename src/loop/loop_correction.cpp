@@ -96,7 +96,6 @@ void LoopCloser::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
     kf->addLoopEdge(loopKf);
   }
   optimiseEssentialGraph(kf, loopKf, nonCorrected, loopLinks, correctedBy);
-  map_.notifyBigChange();
   anyLoop_ = true;
   lastLoopKeyFrame_ = kf->id;
   const LoopClosureEvent event{kf->id, loopKf->id, kf->frameIndex, loop.matched};
@@ -243,8 +242,6 @@ void LoopCloser::runFullBundleAdjustment() {
       p->updateNormalAndDepth();
     }
   }
-  map_.notifyBigChange();
-  ++fullBaMerged_;
   resumeMapping();
 }
 

@@ -165,7 +165,6 @@ bool LocalMapper::processOne() {
       }
     }
   }
-  ++processed_;
   if (sink_) sink_(kf);
   return true;
 }

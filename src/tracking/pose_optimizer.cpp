@@ -62,7 +62,6 @@ int optimizePose(Frame& frame) {
     if (static_cast<int>(edges.size()) - bad < 10) break;
   }
   frame.Tcw = problem.pose(pose);
-  frame.hasPose = true;
   return static_cast<int>(edges.size()) - bad;
 }
 

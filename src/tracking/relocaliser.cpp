@@ -354,7 +354,6 @@ bool Relocaliser::relocalise(Frame& frame) {
     std::vector<MapPoint*> matches;
     if (matching::matchByBow(*kf, frame, matches, options_.bowRatio, true) < options_.minBowMatches) continue;
     if (tryCandidate(frame, *kf, matches, rng)) {
-      frame.hasPose = true;
       ++stats_.successes;
       stats_.lastKeyFrame = kf->id;
       return true;

@@ -112,7 +112,6 @@ TrackResult Tracker::track(Frame frame) {
           current_.points[i] = nullptr;
           current_.outlier[i] = 0;
         }
-      temporaryPoints_.clear();
       temporaryStorage_.clear();
       ScopedStage stage(timer_, "tracking: keyframe decision");
       if (needNewKeyFrame()) {
@@ -135,7 +134,7 @@ TrackResult Tracker::track(Frame frame) {
     result.inliers = matchesInliers_;
     tracked_.push_back({current_.index, current_.timestamp, reference_, current_.Tcw * reference_->Tcw().inverse()});
   }
-  if (state_ != TrackingState::NotInitialised) last_ = current_;
+  if (state_ != TrackingState::NotInitialised) last_ = std::move(current_);  // current_ is refilled next frame
   return result;
 }
 
@@ -143,7 +142,6 @@ bool Tracker::bootstrap(Frame& f) {
   // ORB-SLAM2 starts on any frame with more than 500 keypoints; the map gets those with depth.
   if (static_cast<int>(f.size()) <= options_.minBootstrapFeatures) return false;
   f.Tcw = SE3d();
-  f.hasPose = true;
   computeBow(f);
   KeyFrame* kf = map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics, f.bow, f.featureVector);
   for (std::size_t i = 0; i < f.size(); ++i) {
@@ -156,11 +154,10 @@ bool Tracker::bootstrap(Frame& f) {
     p->updateNormalAndDepth();
     f.points[i] = p;
   }
-  reference_ = lastKeyFrame_ = kf;
+  reference_ = kf;
   lastKeyFrameFrame_ = f.index;
   localKeyFrames_ = {kf};
   localPoints_ = map_.mapPoints();
-  map_.setReferencePoints(localPoints_);
   if (mapper_) mapper_->insertKeyFrame(kf);
   matchesInliers_ = static_cast<int>(localPoints_.size());
   return true;
@@ -217,7 +214,6 @@ void Tracker::updateLastFrame() {
     p->setDescriptor(last_.features->descriptors[i]);
     last_.points[i] = p;
     last_.outlier[i] = 0;
-    temporaryPoints_.push_back(p);
   }
 }
 
@@ -280,7 +276,6 @@ void Tracker::updateLocalMap() {
   for (KeyFrame* kf : localKeyFrames_)
     for (MapPoint* p : kf->points())
       if (p && !p->isBad() && pointsSeen.insert(p).second) localPoints_.push_back(p);
-  map_.setReferencePoints(localPoints_);
 }
 
 int Tracker::searchLocalPoints() {
@@ -383,7 +378,6 @@ void Tracker::createNewKeyFrame() {
     current_.points[i] = p;
     current_.outlier[i] = 0;
   }
-  lastKeyFrame_ = kf;
   lastKeyFrameFrame_ = current_.index;
   if (mapper_) {
     mapper_->insertKeyFrame(kf);

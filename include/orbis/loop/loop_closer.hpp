@@ -11,7 +11,7 @@
 // current keyframe and its covisible keyframes (and their points) moved by the loop transform,
 // duplicated points merged, covisibility updated, loop edges added, the essential graph
 // optimised (spanning tree, loop edges, covisibility ≥ essentialGraphMinWeight; the loop
-// keyframe fixed), Map::notifyBigChange(), then full BA. Full BA runs on its own thread in
+// keyframe fixed), then full BA. Full BA runs on its own thread in
 // threaded mode — aborted and restarted when a new loop closes — and inline in deterministic
 // mode; its result is merged under the map lock with local mapping paused: optimised keyframes
 // take their new poses, keyframes created meanwhile follow their spanning-tree parent, points
@@ -80,8 +80,6 @@ class LoopCloser {
   void shutdown();
 
   std::vector<LoopClosureEvent> closures() const;
-  int fullBundleAdjustmentsMerged() const { return fullBaMerged_.load(); }
-  bool fullBundleAdjustmentRunning() const { return fullBaRunning_.load(); }
 
  private:
   struct ConsistentGroup {
@@ -140,7 +138,6 @@ class LoopCloser {
   std::thread fullBaThread_;
   std::atomic<bool> abortFullBa_{false};
   std::atomic<bool> fullBaRunning_{false};
-  std::atomic<int> fullBaMerged_{0};
 
   std::thread worker_;
 };

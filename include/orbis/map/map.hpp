@@ -37,8 +37,6 @@ class Map {
   std::vector<MapPoint*> mapPoints() const;
   std::size_t keyFrameCount() const;
   std::size_t mapPointCount() const;
-  // Every keyframe ever created (bad ones too), ordered by id — for trajectories.
-  const std::vector<std::unique_ptr<KeyFrame>>& allKeyFrames() const { return keyFrames_; }
   KeyFrame* keyFrame(KeyFrameId id) const { return id < keyFrames_.size() ? keyFrames_[id].get() : nullptr; }
   MapPoint* mapPoint(MapPointId id) const { return id < points_.size() ? points_[id].get() : nullptr; }
   std::size_t createdKeyFrames() const { return keyFrames_.size(); }
@@ -47,21 +45,10 @@ class Map {
   // The first keyframe (the gauge of full BA and the root of the spanning tree).
   KeyFrame* origin() const { return keyFrames_.empty() ? nullptr : keyFrames_.front().get(); }
 
-  // Counts loop closures and full-BA merges: tracking compares it with what it saw last to know
-  // that the map moved under it.
-  void notifyBigChange() { ++bigChanges_; }
-  int bigChanges() const { return bigChanges_.load(); }
-
-  // Points the tracking thread currently matches (for display and reports).
-  void setReferencePoints(std::vector<MapPoint*> points) { referencePoints_ = std::move(points); }
-  const std::vector<MapPoint*>& referencePoints() const { return referencePoints_; }
-
  private:
   mutable std::mutex mutex_;
   std::vector<std::unique_ptr<KeyFrame>> keyFrames_;  // index == id
   std::vector<std::unique_ptr<MapPoint>> points_;     // index == id
-  std::vector<MapPoint*> referencePoints_;
-  std::atomic<int> bigChanges_{0};
 };
 
 }  // namespace orbis

@@ -60,7 +60,6 @@ class LocalMapper {
 
   void setKeyFrameSink(std::function<void(KeyFrame*)> sink) { sink_ = std::move(sink); }
   // Drops points that recent keyframes created but are no longer bad-checked (reset support).
-  std::size_t processedKeyFrames() const { return processed_.load(); }
 
  private:
   void run();
@@ -85,7 +84,6 @@ class LocalMapper {
   std::atomic<bool> abortBA_{false};
   std::atomic<bool> busy_{false};
   std::atomic<bool> finish_{false};
-  std::atomic<std::size_t> processed_{0};
 
   mutable std::mutex stopMutex_;
   bool stopRequested_ = false, stopped_ = false, notStop_ = false;

@@ -26,7 +26,6 @@ struct Frame {
   bool hasBow = false;
 
   SE3d Tcw;
-  bool hasPose = false;
   std::vector<MapPoint*> points;  // one slot per keypoint; null when unmatched
   std::vector<char> outlier;      // set by motion-only BA
 

@@ -97,14 +97,11 @@ class Tracker {
   Frame current_, last_;
   std::optional<SE3d> velocity_;  // Tcw(current) * Twc(last) of the last tracked pair
   KeyFrame* reference_ = nullptr;
-  KeyFrame* lastKeyFrame_ = nullptr;
   std::uint64_t lastKeyFrameFrame_ = 0;
   std::uint64_t lastRelocalisedFrame_ = 0;
   int matchesInliers_ = 0;
-  int seenBigChanges_ = 0;
   std::vector<KeyFrame*> localKeyFrames_;
   std::vector<MapPoint*> localPoints_;
-  std::vector<MapPoint*> temporaryPoints_;  // visual-odometry points, owned here
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
   std::vector<TrackedFrame> tracked_;
 };
