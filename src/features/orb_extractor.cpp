@@ -294,14 +294,14 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
 
     const int step = static_cast<int>(level.step);
     const int blurStep = static_cast<int>(blurred.step);
-    const float scale = scales_.scale[static_cast<std::size_t>(l)];
+    const PyramidLevelMap toBase = pyramid_.levelMap(l);
     for (int idx : selected_) {
       const Corner& c = corners_[static_cast<std::size_t>(idx)];
       const int x = cvRound(c.x), y = cvRound(c.y);
       const float angle = centroidAngle(level.ptr<std::uint8_t>(y) + x, step, circleHalfWidth_);
       OrbDescriptor& d = descriptors.emplace_back();
       briefDescriptor(blurred.ptr<std::uint8_t>(y + b) + x + b, blurStep, angle, d);
-      keypoints.push_back({c.x * scale, c.y * scale, angle, c.response, l});
+      keypoints.push_back({toBase.toBaseX(c.x), toBase.toBaseY(c.y), angle, c.response, l});
     }
   }
 }

@@ -1,5 +1,6 @@
 // Stereo keypoint matching on rectified pairs; see include/orbis/features/stereo_matcher.hpp.
 #include "orbis/features/stereo_matcher.hpp"
+#include "orbis/features/image_pyramid.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -80,12 +81,12 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
     if (bestRight < 0) continue;
 
     // Sub-pixel refinement by patch correlation on the left keypoint's level.
-    const float invScale = scales.invScale[static_cast<std::size_t>(level)];
-    const float scale = scales.scale[static_cast<std::size_t>(level)];
     const cv::Mat& imL = left.pyramid[static_cast<std::size_t>(level)];
     const cv::Mat& imR = right.pyramid[static_cast<std::size_t>(level)];
-    const int uL = cvRound(kl.u * invScale), vL = cvRound(kl.v * invScale);
-    const int uR0 = cvRound(right.keypoints[static_cast<std::size_t>(bestRight)].u * invScale);
+    const PyramidLevelMap mapL = PyramidLevelMap::between(left.pyramid[0], imL);
+    const PyramidLevelMap mapR = PyramidLevelMap::between(right.pyramid[0], imR);
+    const int uL = cvRound(mapL.fromBaseX(kl.u)), vL = cvRound(mapL.fromBaseY(kl.v));
+    const int uR0 = cvRound(mapR.fromBaseX(right.keypoints[static_cast<std::size_t>(bestRight)].u));
     if (uR0 - kSlide - kPatchHalf < 0 || uR0 + kSlide + kPatchHalf >= imR.cols) continue;
     if (vL - kPatchHalf < 0 || vL + kPatchHalf >= imL.rows || uL - kPatchHalf < 0 ||
         uL + kPatchHalf >= imL.cols)
@@ -113,7 +114,7 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
     const float delta = (c1 - c3) / curvature;
     if (delta < -1.f || delta > 1.f) continue;
 
-    float uR = scale * (static_cast<float>(uR0 + bestShift) + delta);
+    float uR = mapR.toBaseX(static_cast<float>(uR0 + bestShift) + delta);
     float disparity = kl.u - uR;
     if (disparity < minDisparity || disparity >= maxDisparity) continue;
     if (disparity <= 0.f) {

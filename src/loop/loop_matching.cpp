@@ -60,7 +60,7 @@ int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<Ma
   const FrameFeatures& f2 = kf2.features();
   matches12.assign(kf1.size(), nullptr);
   std::vector<char> taken2(kf2.size(), 0);
-  matching::RotationHistogram hist;
+  RotationHistogram hist;
   const auto& a = kf1.featureVector();
   const auto& b = kf2.featureVector();
   int matches = 0;
@@ -84,14 +84,17 @@ int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<Ma
         const auto j = static_cast<std::size_t>(best);
         matches12[i] = kf2.point(j);
         taken2[j] = 1;
-        hist.add(f1.keypointsUn[i].angle - f2.keypointsUn[j].angle, i);
+        hist.add(f1.keypointsUn[i].angle - f2.keypointsUn[j].angle, static_cast<int>(i));
         ++matches;
       }
     }
     ++ia;
     ++ib;
   }
-  for (std::size_t i : hist.outliers()) {
+  std::vector<int> rejected;
+  hist.rejected(rejected);
+  for (int r : rejected) {
+    const auto i = static_cast<std::size_t>(r);
     if (matches12[i]) {
       matches12[i] = nullptr;
       --matches;

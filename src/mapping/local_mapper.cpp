@@ -210,21 +210,15 @@ void LocalMapper::cullRecentPoints(KeyFrame* kf) {
 
 namespace {
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
 // Fundamental matrix mapping points of kf1 to epipolar lines of kf2 (x2ᵀ F x1 = 0).
 Eigen::Matrix3d fundamental(const KeyFrame& kf1, const KeyFrame& kf2) {
   const SE3d T21 = kf2.Tcw() * kf1.Tcw().inverse();
-  const Eigen::Matrix3d R = T21.rotationMatrix();
-  const Eigen::Vector3d t = T21.translation();
-  Eigen::Matrix3d K1, K2;
-  K1 << kf1.intrinsics.fx, 0, kf1.intrinsics.cx, 0, kf1.intrinsics.fy, kf1.intrinsics.cy, 0, 0, 1;
-  K2 << kf2.intrinsics.fx, 0, kf2.intrinsics.cx, 0, kf2.intrinsics.fy, kf2.intrinsics.cy, 0, 0, 1;
-  return K2.inverse().transpose() * skew(t) * R * K1.inverse();
+  const auto K = [](const MapIntrinsics& k) {
+    Eigen::Matrix3d m;
+    m << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1;
+    return m;
+  };
+  return fundamentalFromPose(T21.rotationMatrix(), T21.translation(), K(kf1.intrinsics), K(kf2.intrinsics)).cast<double>();
 }
 
 bool reprojectionOk(const KeyFrame& kf, std::size_t i, const Eigen::Vector3d& pc) {

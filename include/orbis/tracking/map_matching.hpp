@@ -13,13 +13,11 @@
 
 #include <Eigen/Core>
 
+#include "orbis/features/matcher.hpp"  // kThHigh, kThLow, RotationHistogram
 #include "orbis/map/map.hpp"
 #include "orbis/tracking/frame.hpp"
 
 namespace orbis::matching {
-
-inline constexpr int kThHigh = 100;  // loose descriptor threshold (ORB-SLAM TH_HIGH)
-inline constexpr int kThLow = 50;    // strict descriptor threshold (ORB-SLAM TH_LOW)
 
 // Where a map point should appear in a frame, if it is in the frustum and within its
 // scale-invariance distance range and viewed at less than 60° from its mean direction.
@@ -57,18 +55,5 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
 // Projects `points` into `kf`; where a keypoint matches, either adds the observation or keeps
 // the better-observed of the two duplicate points. Returns the number of fused points.
 int fuse(KeyFrame& kf, const std::vector<MapPoint*>& points, float radius = 3.0f);
-
-// Rotation-consistency filter: clears the matches whose orientation change falls outside the
-// three most populated bins of a 30-bin histogram.
-class RotationHistogram {
- public:
-  static constexpr int kBins = 30;
-  void add(float angleDelta, std::size_t index);
-  // Indices outside the dominant bins.
-  std::vector<std::size_t> outliers() const;
-
- private:
-  std::vector<std::size_t> bins_[kBins];
-};
 
 }  // namespace orbis::matching

@@ -75,7 +75,12 @@ class Tracker {
   void computeBow(Frame& f) const;
   bool bootstrap(Frame& f);
   bool trackReferenceKeyFrame();
-  bool trackWithMotionModel();
+  // Projects the last frame's matches through `motion` (current from last) and optimises.
+  bool trackWithMotionModel(const SE3d& motion);
+  // The current frame is fewer than n frames after the last relocalisation (if any).
+  bool withinFramesOfRelocalisation(std::uint64_t n) const {
+    return lastRelocalisedFrame_ && current_.index < *lastRelocalisedFrame_ + n;
+  }
   bool trackLocalMap();
   void updateLastFrame();
   void replaceRetiredPoints(Frame& f);
@@ -98,7 +103,7 @@ class Tracker {
   std::optional<SE3d> velocity_;  // Tcw(current) * Twc(last) of the last tracked pair
   KeyFrame* reference_ = nullptr;
   std::uint64_t lastKeyFrameFrame_ = 0;
-  std::uint64_t lastRelocalisedFrame_ = 0;
+  std::optional<std::uint64_t> lastRelocalisedFrame_;
   int matchesInliers_ = 0;
   std::vector<KeyFrame*> localKeyFrames_;
   std::vector<MapPoint*> localPoints_;
