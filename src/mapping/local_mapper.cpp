@@ -349,7 +349,10 @@ void LocalMapper::cullKeyFrames(KeyFrame* kf) {
       }
       if (seenElsewhere >= 3) ++redundant;
     }
-    if (points > 0 && redundant > options_.redundancyRatio * points) k->setBad();
+    if (points > 0 && redundant > options_.redundancyRatio * points) {
+      k->setBad();
+      if (culledSink_) culledSink_(k);
+    }
   }
 }
 

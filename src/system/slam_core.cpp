@@ -40,6 +40,9 @@ SlamCore::SlamCore(std::shared_ptr<const OrbVocabulary> vocabulary, const MapInt
     if (loopCloser_) loopCloser_->insertKeyFrame(kf);
     else database_.add(kf->id, kf->bowVector());
   });
+  // A culled keyframe leaves the database at once (as ORB-SLAM's SetBadFlag does), whether or not
+  // a loop closer runs: relocalisation candidates then count only live keyframes.
+  mapper_->setCulledKeyFrameSink([this](KeyFrame* kf) { database_.erase(kf->id); });
   TrackerOptions trackerOptions;
   trackerOptions.maxFramesBetweenKeyFrames = std::max(1, static_cast<int>(options_.fps + 0.5));
   trackerOptions.localisationOnly = options_.localisationOnly;

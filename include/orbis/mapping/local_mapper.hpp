@@ -59,7 +59,8 @@ class LocalMapper {
   void shutdown();
 
   void setKeyFrameSink(std::function<void(KeyFrame*)> sink) { sink_ = std::move(sink); }
-  // Drops points that recent keyframes created but are no longer bad-checked (reset support).
+  // Called for each keyframe culling retires, with the map mutex held (keyframe database upkeep).
+  void setCulledKeyFrameSink(std::function<void(KeyFrame*)> sink) { culledSink_ = std::move(sink); }
 
  private:
   void run();
@@ -74,7 +75,7 @@ class LocalMapper {
   Map& map_;
   LocalMapperOptions options_;
   StageTimer* timer_;
-  std::function<void(KeyFrame*)> sink_;
+  std::function<void(KeyFrame*)> sink_, culledSink_;
 
   mutable std::mutex queueMutex_;
   std::condition_variable queueCv_;
