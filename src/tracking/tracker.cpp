@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <map>
 
 #include "orbis/mapping/local_mapper.hpp"
 #include "orbis/tracking/map_matching.hpp"
@@ -246,8 +245,10 @@ bool Tracker::trackWithMotionModel(const SE3d& motion) {
 }
 
 void Tracker::updateLocalMap() {
-  // Keyframes observing the frame's points, weighted by how many they observe.
-  std::map<KeyFrame*, int, ById> counter;
+  // Stamps instead of per-frame sets: frame index + 1, so a fresh object (0) is never marked.
+  const std::uint64_t stamp = current_.index + 1;
+  // Keyframes observing the frame's points, weighted by how many they observe, in id order.
+  std::vector<KeyFrame*> observers;
   for (std::size_t i = 0; i < current_.size(); ++i) {
     MapPoint* p = current_.points[i];
     if (!p) continue;
@@ -255,42 +256,56 @@ void Tracker::updateLocalMap() {
       current_.points[i] = nullptr;
       continue;
     }
-    for (const auto& [kf, idx] : p->observations()) ++counter[kf];
+    for (const auto& [kf, idx] : p->observations()) {
+      if (kf->countedFor != stamp) {
+        kf->countedFor = stamp;
+        kf->sharedMatches = 0;
+        observers.push_back(kf);
+      }
+      ++kf->sharedMatches;
+    }
   }
-  if (counter.empty()) return;
+  if (observers.empty()) return;
+  std::sort(observers.begin(), observers.end(), ById{});
   std::vector<KeyFrame*> local;
-  std::set<KeyFrame*, ById> seen;
   KeyFrame* best = nullptr;
   int bestCount = 0;
-  for (const auto& [kf, n] : counter) {
+  for (KeyFrame* kf : observers) {
     if (kf->isBad()) continue;
-    if (n > bestCount) { bestCount = n; best = kf; }
+    if (kf->sharedMatches > bestCount) { bestCount = kf->sharedMatches; best = kf; }
     local.push_back(kf);
-    seen.insert(kf);
+    kf->inLocalMapOf = stamp;
   }
   // Neighbours: best covisibles, children and parent of the first-level keyframes (ORB-SLAM's
   // UpdateLocalKeyFrames), up to 80 in all.
+  auto firstVisit = [stamp](KeyFrame* kf) {
+    if (kf->inLocalMapOf == stamp) return false;
+    kf->inLocalMapOf = stamp;
+    return true;
+  };
   const std::size_t firstLevel = local.size();
   for (std::size_t k = 0; k < firstLevel && local.size() < 80; ++k) {
     KeyFrame* kf = local[k];
     for (KeyFrame* n : kf->bestCovisibles(10))
-      if (!n->isBad() && seen.insert(n).second) { local.push_back(n); break; }
+      if (!n->isBad() && firstVisit(n)) { local.push_back(n); break; }
     for (KeyFrame* c : kf->children())
-      if (!c->isBad() && seen.insert(c).second) { local.push_back(c); break; }
-    if (KeyFrame* parent = kf->parent(); parent && seen.insert(parent).second) local.push_back(parent);
+      if (!c->isBad() && firstVisit(c)) { local.push_back(c); break; }
+    if (KeyFrame* parent = kf->parent(); parent && firstVisit(parent)) local.push_back(parent);
   }
   localKeyFrames_ = std::move(local);
   if (best) reference_ = best;
   // Their points, each once, in keyframe order.
-  std::set<MapPoint*, ById> pointsSeen;
   localPoints_.clear();
   for (KeyFrame* kf : localKeyFrames_)
     for (MapPoint* p : kf->points())
-      if (p && !p->isBad() && pointsSeen.insert(p).second) localPoints_.push_back(p);
+      if (p && !p->isBad() && p->inLocalMapOf != stamp) {
+        p->inLocalMapOf = stamp;
+        localPoints_.push_back(p);
+      }
 }
 
 int Tracker::searchLocalPoints() {
-  std::set<MapPoint*, ById> alreadyMatched;
+  const std::uint64_t stamp = current_.index + 1;
   for (std::size_t i = 0; i < current_.size(); ++i) {
     MapPoint* p = current_.points[i];
     if (!p) continue;
@@ -299,12 +314,12 @@ int Tracker::searchLocalPoints() {
       continue;
     }
     p->increaseVisible();
-    alreadyMatched.insert(p);
+    p->matchedIn = stamp;
   }
   std::vector<MapPoint*> candidates;
   std::vector<matching::Projection> projections;
   for (MapPoint* p : localPoints_) {
-    if (alreadyMatched.count(p) || p->isBad()) continue;
+    if (p->matchedIn == stamp || p->isBad()) continue;
     matching::Projection pr;
     if (!matching::projectIntoFrame(*p, current_.Tcw, current_.intrinsics, current_.features->scales, pr)) continue;
     p->increaseVisible();

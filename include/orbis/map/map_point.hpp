@@ -73,6 +73,11 @@ class MapPoint {
   int found() const { return found_; }
   float foundRatio() const { return static_cast<float>(found_) / static_cast<float>(visible_); }
 
+  // Per-frame marks of the tracker (guarded by the map mutex like the rest): the frame, plus one,
+  // whose local map last listed the point and whose matches last held it. They replace sets
+  // rebuilt every frame.
+  std::uint64_t inLocalMapOf = 0, matchedIn = 0;
+
   // Recomputes the representative descriptor: the observation with least median distance to
   // the others.
   void computeDistinctiveDescriptor();
