@@ -46,15 +46,7 @@ void plot(const std::string& file, std::string title, const Trajectory& gt, Traj
           const char* levelFormat) {
   eval::EvaluationPlot picture;
   picture.title = std::move(title);
-  // Only the ground truth of the span the estimate covers (and a second either side): a short
-  // run evaluated against a whole sequence's ground truth would otherwise be a speck in the view.
-  if (aligned.empty()) {
-    picture.groundTruth = gt;
-  } else {
-    const double t0 = aligned.front().t - 1.0, t1 = aligned.back().t + 1.0;
-    for (const StampedPose& g : gt)
-      if (g.t >= t0 && g.t <= t1) picture.groundTruth.push_back(g);
-  }
+  picture.groundTruth = posesCovering(gt, aligned, 1.0);
   picture.estimate = std::move(aligned);
   picture.errorTimes = std::move(times);
   picture.errors = std::move(errors);

@@ -205,6 +205,15 @@ Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
   return trajectory;
 }
 
+Trajectory posesCovering(const Trajectory& trajectory, const Trajectory& span, double marginSeconds) {
+  if (span.empty()) return trajectory;
+  const double t0 = span.front().t - marginSeconds, t1 = span.back().t + marginSeconds;
+  Trajectory out;
+  for (const StampedPose& s : trajectory)
+    if (s.t >= t0 && s.t <= t1) out.push_back(s);
+  return out;
+}
+
 std::vector<std::pair<std::size_t, std::size_t>> associateTimestamps(const std::vector<double>& a,
                                                                      const std::vector<double>& b,
                                                                      double maxDt) {

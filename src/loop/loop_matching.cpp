@@ -91,15 +91,7 @@ int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<Ma
     ++ia;
     ++ib;
   }
-  std::vector<int> rejected;
-  hist.rejected(rejected);
-  for (int r : rejected) {
-    const auto i = static_cast<std::size_t>(r);
-    if (matches12[i]) {
-      matches12[i] = nullptr;
-      --matches;
-    }
-  }
+  matches -= hist.clearRejected(matches12);
   return matches;
 }
 

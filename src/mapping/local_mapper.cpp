@@ -1,6 +1,5 @@
 #include "orbis/mapping/local_mapper.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 

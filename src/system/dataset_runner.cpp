@@ -194,10 +194,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
       for (auto& s : scene.estimate) s.pose = eval::applySimilarity(S, s.pose);
       for (auto& s : scene.keyFrames) s.pose = eval::applySimilarity(S, s.pose);
       for (auto& p : scene.mapPoints) p = (S * p.cast<double>()).cast<float>();
-      // Only the stretch of ground truth the run covers.
-      const double t0 = trajectory.front().t - 0.5, t1 = trajectory.back().t + 0.5;
-      for (const StampedPose& g : gt)
-        if (g.t >= t0 && g.t <= t1) scene.groundTruth.push_back(g);
+      scene.groundTruth = posesCovering(gt, trajectory, 0.5);
     } catch (const Error& e) {
       report.warnings.push_back(std::string("ATE not computed: ") + e.what());
     }

@@ -12,21 +12,6 @@ constexpr float kViewCosFrontal = 0.998f;
 
 float radiusForViewCos(float viewCos) { return viewCos > kViewCosFrontal ? 2.5f : 4.0f; }
 
-// Clears the rotation outliers from a match list (slots indexed by keypoint).
-template <class Slots>
-int dropRotationOutliers(const RotationHistogram& hist, Slots& slots) {
-  std::vector<int> rejected;
-  hist.rejected(rejected);
-  int dropped = 0;
-  for (int i : rejected) {
-    if (slots[static_cast<std::size_t>(i)] != nullptr) {
-      slots[static_cast<std::size_t>(i)] = nullptr;
-      ++dropped;
-    }
-  }
-  return dropped;
-}
-
 }  // namespace
 
 bool projectIntoFrame(const MapPoint& point, const SE3d& Tcw, const MapIntrinsics& K, const ScaleLevels& levels,
@@ -93,7 +78,7 @@ int matchFromLastFrame(Frame& current, const Frame& last, float radius, bool che
       if (checkOrientation) hist.add(last.features->keypointsUn[i].angle - cf.keypointsUn[best].angle, static_cast<int>(best));
     }
   }
-  if (checkOrientation) matches -= dropRotationOutliers(hist, current.points);
+  if (checkOrientation) matches -= hist.clearRejected(current.points);
   return matches;
 }
 
@@ -162,7 +147,7 @@ int matchByBow(const KeyFrame& kf, const Frame& frame, std::vector<MapPoint*>& o
     ++ia;
     ++ib;
   }
-  if (checkOrientation) matches -= dropRotationOutliers(hist, out);
+  if (checkOrientation) matches -= hist.clearRejected(out);
   return matches;
 }
 
@@ -198,7 +183,7 @@ int matchFromKeyFrame(Frame& frame, const KeyFrame& kf, const std::set<MapPoint*
       hist.add(kf.features().keypointsUn[i].angle - f.keypointsUn[best].angle, static_cast<int>(best));
     }
   }
-  matches -= dropRotationOutliers(hist, frame.points);
+  matches -= hist.clearRejected(frame.points);
   return matches;
 }
 

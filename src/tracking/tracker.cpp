@@ -43,6 +43,20 @@ std::vector<std::size_t> keypointsToLift(const Frame& f) {
   return lift;
 }
 
+// A map point at keypoint i's depth, observed by kf and matched in f; null without depth.
+MapPoint* createPointFromDepth(Map& map, Frame& f, KeyFrame* kf, std::size_t i) {
+  Eigen::Vector3d pw;
+  if (!f.unprojectStereo(i, pw)) return nullptr;
+  MapPoint* p = map.createMapPoint(pw, kf, f.index);
+  p->addObservation(kf, i);
+  kf->setPoint(i, p);
+  p->computeDistinctiveDescriptor();
+  p->updateNormalAndDepth();
+  f.points[i] = p;
+  f.outlier[i] = 0;
+  return p;
+}
+
 }  // namespace
 
 SE3d Tracker::worldPose(const TrackedFrame& f) {
@@ -152,16 +166,7 @@ bool Tracker::bootstrap(Frame& f) {
   f.Tcw = SE3d();
   computeBow(f);
   KeyFrame* kf = map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics, f.bow, f.featureVector);
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    Eigen::Vector3d pw;
-    if (!f.unprojectStereo(i, pw)) continue;
-    MapPoint* p = map_.createMapPoint(pw, kf, f.index);
-    p->addObservation(kf, i);
-    kf->setPoint(i, p);
-    p->computeDistinctiveDescriptor();
-    p->updateNormalAndDepth();
-    f.points[i] = p;
-  }
+  for (std::size_t i = 0; i < f.size(); ++i) createPointFromDepth(map_, f, kf, i);
   reference_ = kf;
   lastKeyFrameFrame_ = f.index;
   localKeyFrames_ = {kf};
@@ -257,8 +262,8 @@ void Tracker::updateLocalMap() {
       continue;
     }
     for (const auto& [kf, idx] : p->observations()) {
-      if (kf->countedFor != stamp) {
-        kf->countedFor = stamp;
+      if (kf->inLocalMapOf != stamp) {
+        kf->inLocalMapOf = stamp;
         kf->sharedMatches = 0;
         observers.push_back(kf);
       }
@@ -274,7 +279,6 @@ void Tracker::updateLocalMap() {
     if (kf->isBad()) continue;
     if (kf->sharedMatches > bestCount) { bestCount = kf->sharedMatches; best = kf; }
     local.push_back(kf);
-    kf->inLocalMapOf = stamp;
   }
   // Neighbours: best covisibles, children and parent of the first-level keyframes (ORB-SLAM's
   // UpdateLocalKeyFrames), up to 80 in all.
@@ -393,17 +397,7 @@ void Tracker::createNewKeyFrame() {
     if (current_.points[i]) kf->setPoint(i, current_.points[i]);
   // Close stereo points become map points at once (paper §III-A); far ones only while fewer than
   // 100 points were added, nearest first.
-  for (const std::size_t i : keypointsToLift(current_)) {
-    Eigen::Vector3d pw;
-    current_.unprojectStereo(i, pw);
-    MapPoint* p = map_.createMapPoint(pw, kf, current_.index);
-    p->addObservation(kf, i);
-    kf->setPoint(i, p);
-    p->computeDistinctiveDescriptor();
-    p->updateNormalAndDepth();
-    current_.points[i] = p;
-    current_.outlier[i] = 0;
-  }
+  for (const std::size_t i : keypointsToLift(current_)) createPointFromDepth(map_, current_, kf, i);
   lastKeyFrameFrame_ = current_.index;
   if (mapper_) {
     mapper_->insertKeyFrame(kf);

@@ -133,4 +133,15 @@ TEST_F(TrajectoryIoTest, MissingFilesAndMismatchedTimesAreErrors) {
   EXPECT_THROW(orbis::parseTrajectoryFormat("ply"), orbis::Error);
 }
 
+TEST(TrajectorySpan, PosesCoveringKeepsTheSpanPlusMargin) {
+  Trajectory gt;
+  for (int i = 0; i < 10; ++i) gt.push_back({static_cast<double>(i), orbis::SE3d()});
+  const Trajectory estimate{{3.2, orbis::SE3d()}, {5.0, orbis::SE3d()}};
+  const Trajectory covered = orbis::posesCovering(gt, estimate, 1.0);
+  ASSERT_EQ(covered.size(), 4u);  // 2.2 .. 6.0 holds 3, 4, 5, 6
+  EXPECT_EQ(covered.front().t, 3.0);
+  EXPECT_EQ(covered.back().t, 6.0);
+  EXPECT_EQ(orbis::posesCovering(gt, {}, 1.0).size(), gt.size());
+}
+
 }  // namespace

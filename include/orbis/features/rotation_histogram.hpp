@@ -31,6 +31,20 @@ class RotationHistogram {
     bins_[static_cast<std::size_t>(bin)].push_back(item);
   }
 
+  // Nulls the slots (indexed by item) of the rejected items; returns how many held something.
+  template <class Slots>
+  int clearRejected(Slots& slots) const {
+    std::vector<int> drop;
+    rejected(drop);
+    int cleared = 0;
+    for (int i : drop) {
+      auto& slot = slots[static_cast<std::size_t>(i)];
+      if (slot) ++cleared;
+      slot = nullptr;
+    }
+    return cleared;
+  }
+
   // Items to drop, appended to `out` (which is not cleared).
   void rejected(std::vector<int>& out) const {
     int first = -1, second = -1, third = -1;

@@ -59,6 +59,11 @@ std::vector<std::pair<std::size_t, std::size_t>> associateTimestamps(const std::
                                                                      const std::vector<double>& b,
                                                                      double maxDt);
 
+// The poses of `trajectory` from `span`'s first timestamp minus `marginSeconds` to its last plus
+// `marginSeconds` (all of them when `span` is empty): the ground truth an estimate covers, so a
+// short run drawn over a whole sequence's ground truth is not a speck in the view.
+Trajectory posesCovering(const Trajectory& trajectory, const Trajectory& span, double marginSeconds);
+
 // ---- Text tables, shared with the dataset adapters ------------------------------------------
 // One data row of a text table: its 1-based line number and its fields (split on whitespace
 // and commas; blank lines and lines starting with '#' are skipped). The views die with the row.

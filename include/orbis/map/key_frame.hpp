@@ -108,7 +108,7 @@ class KeyFrame {
 
   // Per-frame marks of the tracker (map mutex held): the frame, plus one, whose local map last
   // listed this keyframe, and how many of that frame's matches it observes.
-  std::uint64_t inLocalMapOf = 0, countedFor = 0;
+  std::uint64_t inLocalMapOf = 0;
   int sharedMatches = 0;
 
   // Indices of keypoints within radius r of (u, v) (undistorted pixels).
