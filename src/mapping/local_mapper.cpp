@@ -217,7 +217,7 @@ Eigen::Matrix3d fundamental(const KeyFrame& kf1, const KeyFrame& kf2) {
     m << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1;
     return m;
   };
-  return fundamentalFromPose(T21.rotationMatrix(), T21.translation(), K(kf1.intrinsics), K(kf2.intrinsics)).cast<double>();
+  return fundamentalFromPose(T21.rotationMatrix(), T21.translation(), K(kf1.intrinsics), K(kf2.intrinsics));
 }
 
 bool reprojectionOk(const KeyFrame& kf, std::size_t i, const Eigen::Vector3d& pc) {

@@ -231,11 +231,11 @@ int searchForInitialization(const FrameFeatures& f1, const FrameFeatures& f2,
 
 // F21 such that x2^T F21 x1 = 0 for pixels of a rigid scene: K2^-T [t21]x R21 K1^-1, where
 // X2 = R21 X1 + t21.
-inline Eigen::Matrix3f fundamentalFromPose(const Eigen::Matrix3d& R21, const Eigen::Vector3d& t21,
+inline Eigen::Matrix3d fundamentalFromPose(const Eigen::Matrix3d& R21, const Eigen::Vector3d& t21,
                                            const Eigen::Matrix3d& K1, const Eigen::Matrix3d& K2) {
   Eigen::Matrix3d tx;
   tx << 0, -t21.z(), t21.y(), t21.z(), 0, -t21.x(), -t21.y(), t21.x(), 0;
-  return (K2.inverse().transpose() * tx * R21 * K1.inverse()).cast<float>();
+  return K2.inverse().transpose() * tx * R21 * K1.inverse();
 }
 
 struct EpipolarSearchOptions {
@@ -248,10 +248,11 @@ struct EpipolarSearchOptions {
 // Pairs (i1, i2) of keypoints consistent with F21; epipole2 is camera 1's centre in image 2.
 template <class Distance = HammingDistance>
   requires DescriptorDistance<Distance>
-int searchForTriangulation(const FrameFeatures& f1, const FrameFeatures& f2, const Eigen::Matrix3f& F21,
+int searchForTriangulation(const FrameFeatures& f1, const FrameFeatures& f2, const Eigen::Matrix3d& F21d,
                            const Eigen::Vector2f& epipole2, const EpipolarSearchOptions& options,
                            std::vector<std::pair<int, int>>& pairs, const Distance& distance = {}) {
   pairs.clear();
+  const Eigen::Matrix3f F21 = F21d.cast<float>();
   const std::vector<std::uint8_t> taken1 = detail::takenMask(options.taken1, f1.size());
   std::vector<std::uint8_t> taken2 = detail::takenMask(options.taken2, f2.size());
   const bool grouped = !options.group1.empty() && !options.group2.empty();
