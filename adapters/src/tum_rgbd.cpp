@@ -99,7 +99,8 @@ class TumRgbdReader final : public DatasetReader {
                   "sequence; give the calibration in a settings file");
     if (sensor_ == SensorKind::Monocular) return *pinhole;
     // Frames carry the raw 16-bit depth; the camera says how it becomes metres.
-    return RgbdCamera<double>(*pinhole, options_.tumVirtualBaseline, options_.tumDepthScale);
+    const double baseline = options_.tumVirtualBaseline.value_or(options_.tumBf / pinhole->fx);
+    return RgbdCamera<double>(*pinhole, baseline, options_.tumDepthScale);
   }
 
   RadTanDistortion<double> distortion() const override {

@@ -340,6 +340,8 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
     kf.timestamp = r.get<double>("keyframe");
     kf.Tcw = r.getPose("keyframe pose");
     kf.intrinsics = r.getIntrinsics("keyframe camera");
+    // Not saved: how much BA trusts depth readings is the running system's noise model.
+    kf.intrinsics.disparitySigma = expected.intrinsics.disparitySigma;
     kf.features = readFeatures(r);
     kf.bow.resize(r.count(sizeof(bow::WordId) + sizeof(bow::WordValue), "bag of words"));
     for (bow::WordEntry& e : kf.bow) {

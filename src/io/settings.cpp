@@ -111,6 +111,7 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
   }
   if (yaml.has("ThDepth")) s.thDepth = positive(yaml, "ThDepth");
   if (yaml.has("DepthMapFactor")) s.depthMapFactor = positive(yaml, "DepthMapFactor");
+  if (yaml.has("DepthDisparitySigma")) s.depthDisparitySigma = positive(yaml, "DepthDisparitySigma");
   if (yaml.has("LEFT.K") || yaml.has("RIGHT.K")) {
     s.rectification = StereoRectificationBlocks{readBlock(yaml, "LEFT."), readBlock(yaml, "RIGHT.")};
   }
@@ -127,7 +128,9 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
         s.camera = RectifiedStereoCamera<double>(pinhole, baseline, closeDepth);
       } else {
         if (!yaml.has("DepthMapFactor")) throw yaml.error("DepthMapFactor", "missing (required for rgbd)");
-        s.camera = RgbdCamera<double>(pinhole, baseline, s.depthMapFactor, closeDepth);
+        RgbdCamera<double> rgbd(pinhole, baseline, s.depthMapFactor, closeDepth);
+        rgbd.disparitySigma = s.depthDisparitySigma;
+        s.camera = rgbd;
       }
       break;
     }

@@ -22,7 +22,7 @@ struct Observation {
   std::size_t keypoint;
   ResidualId id;
   int pose, pointIndex;
-  bool stereo;
+  bool threeDof;  // stereo or depth residual: the 3-DOF χ² test
 };
 
 // A BA problem copied out of the map: the keyframes (free or fixed), points and observations.
@@ -38,7 +38,7 @@ struct BaSnapshot {
 // points enter fixed. The origin keyframe is always fixed (gauge). Caller holds the map mutex.
 void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points) {
   const MapIntrinsics& K = free.front()->intrinsics;
-  s.cameras = std::make_unique<optim::ObservationCameras>(K.fx, K.fy, K.cx, K.cy, K.bf);
+  s.cameras = std::make_unique<optim::ObservationCameras>(K.fx, K.fy, K.cx, K.cy, K.bf, K.disparitySigma);
   std::map<KeyFrame*, int, ById> poseOf;
   for (KeyFrame* kf : free) {
     poseOf[kf] = s.problem.addPose(kf->Tcw(), kf->id == 0);
@@ -57,14 +57,8 @@ void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std:
       const FrameFeatures& f = kf->features();
       const Keypoint& k = f.keypointsUn[index];
       const double information = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
-      Observation o{kf, p, index, {}, it->second, pi, f.uRight[index] >= 0};
-      if (!o.stereo) {
-        const optim::MonoReprojection r{{k.u, k.v}, &s.cameras->mono};
-        o.id = s.problem.add(r, it->second, pi, information, optim::kChi2Mono);
-      } else {
-        const optim::StereoReprojection r{{k.u, k.v, f.uRight[index]}, &s.cameras->stereo};
-        o.id = s.problem.add(r, it->second, pi, information, optim::kChi2Stereo);
-      }
+      Observation o{kf, p, index, {}, it->second, pi, false};
+      o.id = s.cameras->add(s.problem, it->second, pi, k.u, k.v, f.uRight[index], information, o.threeDof);
       s.observations.push_back(o);
     }
   }
@@ -72,14 +66,8 @@ void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std:
 
 bool isOutlier(const BaSnapshot& s, const Observation& o) {
   const double chi2 = s.problem.chi2(o.id);
-  if (chi2 > (o.stereo ? optim::kChi2Stereo : optim::kChi2Mono)) return true;
+  if (chi2 > (o.threeDof ? optim::kChi2Stereo : optim::kChi2Mono)) return true;
   return (s.problem.pose(o.pose) * s.problem.point(o.pointIndex)).z() <= 0;
-}
-
-void dropKernel(BaSnapshot& s, const Observation& o) {
-  const auto index = static_cast<std::size_t>(o.id.index);
-  if (o.stereo) s.problem.records<1>()[index].delta2 = std::numeric_limits<double>::infinity();
-  else s.problem.records<0>()[index].delta2 = std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -115,7 +103,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::at
     // Second pass without the outliers and without the kernel (ORB-SLAM's LocalBundleAdjustment).
     for (const Observation& o : s.observations) {
       if (isOutlier(s, o)) s.problem.setActive(o.id, false);
-      dropKernel(s, o);
+      s.problem.setKernelThreshold(o.id, std::numeric_limits<double>::infinity());
     }
     options.maxIterations = 10;
     s.problem.solve(options);

@@ -9,7 +9,7 @@
 namespace orbis {
 
 MapIntrinsics makeMapIntrinsics(const PinholeCamera<double>& pinhole, double bf, double closeDepth, int width,
-                                int height) {
+                                int height, double disparitySigma) {
   MapIntrinsics k;
   k.fx = pinhole.fx;
   k.fy = pinhole.fy;
@@ -17,6 +17,7 @@ MapIntrinsics makeMapIntrinsics(const PinholeCamera<double>& pinhole, double bf,
   k.cy = pinhole.cy;
   k.bf = bf;
   k.closeDepth = closeDepth;
+  k.disparitySigma = disparitySigma;
   k.maxX = width;
   k.maxY = height;
   return k;

@@ -10,14 +10,14 @@ namespace orbis {
 int optimizePose(Frame& frame) {
   using namespace optim;
   const MapIntrinsics& K = frame.intrinsics;
-  const ObservationCameras cameras(K.fx, K.fy, K.cx, K.cy, K.bf);
+  const ObservationCameras cameras(K.fx, K.fy, K.cx, K.cy, K.bf, K.disparitySigma);
   const FrameFeatures& f = *frame.features;
   SlamProblem problem;
   const int pose = problem.addPose(frame.Tcw);
   struct Edge {
     std::size_t keypoint;
     ResidualId id;
-    bool stereo;
+    bool threeDof;
   };
   std::vector<Edge> edges;
   edges.reserve(frame.size());
@@ -28,13 +28,9 @@ int optimizePose(Frame& frame) {
     const int point = problem.addPoint(p->position(), /*fixed=*/true);
     const Keypoint& k = f.keypointsUn[i];
     const double information = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
-    if (f.uRight[i] < 0) {
-      const MonoReprojection r{{k.u, k.v}, &cameras.mono};
-      edges.push_back({i, problem.add(r, pose, point, information, kChi2Mono), false});
-    } else {
-      const StereoReprojection r{{k.u, k.v, f.uRight[i]}, &cameras.stereo};
-      edges.push_back({i, problem.add(r, pose, point, information, kChi2Stereo), true});
-    }
+    Edge e{i, {}, false};
+    e.id = cameras.add(problem, pose, point, k.u, k.v, f.uRight[i], information, e.threeDof);
+    edges.push_back(e);
   }
   if (edges.size() < 3) return 0;
 
@@ -50,14 +46,11 @@ int optimizePose(Frame& frame) {
     bad = 0;
     for (const Edge& e : edges) {
       const double chi2 = problem.chi2(e.id);
-      const bool isOutlier = chi2 > (e.stereo ? kChi2Stereo : kChi2Mono);
+      const bool isOutlier = chi2 > (e.threeDof ? kChi2Stereo : kChi2Mono);
       frame.outlier[e.keypoint] = isOutlier ? 1 : 0;
       problem.setActive(e.id, !isOutlier);
       bad += isOutlier ? 1 : 0;
-      if (round == 2) {
-        if (e.stereo) problem.records<1>()[static_cast<std::size_t>(e.id.index)].delta2 = std::numeric_limits<double>::infinity();
-        else problem.records<0>()[static_cast<std::size_t>(e.id.index)].delta2 = std::numeric_limits<double>::infinity();
-      }
+      if (round == 2) problem.setKernelThreshold(e.id, std::numeric_limits<double>::infinity());
     }
     if (static_cast<int>(edges.size()) - bad < 10) break;
   }

@@ -70,7 +70,8 @@ TEST(RealDatasets, TumTeddyAllFramesWithDepth) {
 
   const auto camera = std::get<orbis::RgbdCamera<double>>(reader->camera());
   EXPECT_DOUBLE_EQ(camera.pinhole.fx, 535.4);
-  EXPECT_NEAR(camera.bf(), 535.4 * 0.08, 1e-9);
+  EXPECT_NEAR(camera.bf(), 40.0, 1e-9);  // ORB-SLAM2's Camera.bf for every Kinect
+  EXPECT_DOUBLE_EQ(camera.disparitySigma, orbis::RgbdCamera<double>::kDefaultDisparitySigma);
 
   // Raw depth through the camera's factor: the Kinect sees the teddy scene between ~0.5 and ~5 m.
   const orbis::DatasetFrame f = reader->frame(100);

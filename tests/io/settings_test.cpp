@@ -73,6 +73,7 @@ TEST(Settings, TumFilesAreRgbdWithVirtualBaseline) {
   EXPECT_NEAR(camera.bf(), 40.0, 1e-12);
   EXPECT_NEAR(camera.closeDepthThreshold(), 40.0 * 40.0 / 517.306408, 1e-12);  // ThDepth * bf / fx
   EXPECT_DOUBLE_EQ(camera.depthScale, 5000.0);
+  EXPECT_DOUBLE_EQ(camera.disparitySigma, 0.125);
   EXPECT_DOUBLE_EQ(s.distortion.k3, 1.163314);
   EXPECT_DOUBLE_EQ(s.distortion.p1, -0.005358);
   EXPECT_TRUE(s.rgbOrder);
@@ -160,6 +161,8 @@ TEST_F(MalformedSettings, WrongTypeOrValue) {
                  "ORBextractor.nLevels");
   expectKeyError("sequence_bf.yaml", replaced(tum1_, "Camera.bf: 40.0", "Camera.bf: [40.0, 1]"), "Camera.bf");
   expectKeyError("unknown_sensor.yaml", replaced(tum1_, "System.seed: 0", "Sensor: lidar"), "Sensor");
+  expectKeyError("zero_disparity_sigma.yaml", replaced(tum1_, "DepthDisparitySigma: 0.125", "DepthDisparitySigma: 0"),
+                 "DepthDisparitySigma");
   const std::string euroc = slurp(settingsDir() / "EuRoC.yaml");
   expectKeyError("short_P.yaml", replaced(euroc, "   rows: 3\n   cols: 4\n   dt: d\n   data: [435.2046959714599, 0, 367.4517211914062, -47",
                                           "   rows: 3\n   cols: 3\n   dt: d\n   data: [435.2046959714599, 0, 367.4517211914062, -47"),

@@ -62,6 +62,39 @@ TEST(OptimResiduals, RgbdReprojectionJacobians) {
   EXPECT_LT(worst, 1e-6);
 }
 
+TEST(OptimResiduals, DisparityReprojectionJacobians) {
+  const RgbdCamera<double> camera({535.4, 539.2, 320.1, 247.6, 640, 480}, 40.0 / 535.4, 5000.0);
+  std::mt19937 rng(5);
+  double worst = 0.0;
+  for (const double weight : {1.0, 8.0, 30.0}) {
+    for (int trial = 0; trial < 50; ++trial) {
+      const SE3d pose = randomPose(rng, 0.8, 1.0);
+      const DisparityReprojection<RgbdCamera<double>> residual{{310.0, 240.0, 290.0}, &camera, weight};
+      worst = std::max(worst, test::checkJacobians(residual, pose, pointInFront(rng, pose)).relative());
+    }
+  }
+  std::printf("DisparityReprojection (3x6x3): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
+// The depth residual's rows are the keypoint's and the weighted disparity's: a keypoint found
+// 0.5 px left of where its point projects, with a depth reading 0.2 px of disparity too near,
+// gives (0.5, 0, -0.2 w) where the stereo residual mixes the two errors into (0.5, 0, 0.7).
+TEST(OptimResiduals, DisparityReprojectionSeparatesKeypointAndDepthErrors) {
+  const RgbdCamera<double> camera({535.4, 539.2, 320.1, 247.6, 640, 480}, 40.0 / 535.4, 5000.0);
+  const Eigen::Vector3d pc(0.1, -0.2, 1.6);
+  const Eigen::Vector3d ideal = camera.project(pc);
+  const Eigen::Vector3d measured(ideal.x() - 0.5, ideal.y(), ideal.z() - 0.5 - 0.2);
+  Eigen::Vector3d stereo, depth;
+  Reprojection<RgbdCamera<double>>{measured, &camera}.evaluate(SE3d(), pc, stereo, nullptr, nullptr);
+  DisparityReprojection<RgbdCamera<double>>{measured, &camera, 8.0}.evaluate(SE3d(), pc, depth, nullptr, nullptr);
+  EXPECT_NEAR(stereo.x(), 0.5, 1e-9);
+  EXPECT_NEAR(stereo.z(), 0.7, 1e-9);
+  EXPECT_NEAR(depth.x(), 0.5, 1e-9);
+  EXPECT_NEAR(depth.y(), 0.0, 1e-9);
+  EXPECT_NEAR(depth.z(), 8.0 * -0.2, 1e-9);
+}
+
 TEST(OptimResiduals, RelativePoseSE3Jacobians) {
   std::mt19937 rng(4);
   double worst = 0.0;

@@ -93,7 +93,13 @@ template <class S = double>
 struct RgbdCamera : detail::StereoGeometry<S> {
   using Base = detail::StereoGeometry<S>;
 
+  // σ of the virtual disparity bf/d in pixels, beside a level-0 keypoint's 1 px (settings
+  // DepthDisparitySigma). BA weighs a depth reading by it (optim/reprojection.hpp:
+  // DisparityReprojection) instead of as a second keypoint's coordinate.
+  static constexpr S kDefaultDisparitySigma = S(0.125);
+
   S depthScale = S(1);  // settings DepthMapFactor: raw depth value / depthScale = metres
+  S disparitySigma = kDefaultDisparitySigma;
 
   RgbdCamera() = default;
   RgbdCamera(const PinholeCamera<S>& pinhole, S virtualBaseline, S depthScaleFactor)
@@ -111,8 +117,9 @@ struct RgbdCamera : detail::StereoGeometry<S> {
 
   template <class T>
   RgbdCamera<T> cast() const {
-    return {this->pinhole.template cast<T>(), T(this->baseline), T(depthScale),
-            T(this->closeDepth)};
+    RgbdCamera<T> c{this->pinhole.template cast<T>(), T(this->baseline), T(depthScale), T(this->closeDepth)};
+    c.disparitySigma = T(disparitySigma);
+    return c;
   }
 };
 

@@ -52,6 +52,8 @@ struct Settings {
   bool rgbOrder = true;        // Camera.RGB: colour images arrive as RGB (1) or BGR (0)
   double thDepth = 40.0;       // ThDepth: close/far threshold in baselines
   double depthMapFactor = 1.0; // DepthMapFactor: raw depth / factor = metres (rgbd only)
+  // DepthDisparitySigma (orbis only): σ of the depth sensor's virtual disparity, px (rgbd only)
+  double depthDisparitySigma = RgbdCamera<double>::kDefaultDisparitySigma;
   std::optional<StereoRectificationBlocks> rectification;  // LEFT./RIGHT. blocks, if present
   std::uint32_t seed = 0;      // System.seed: seeds every random choice of the system
 

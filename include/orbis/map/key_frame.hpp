@@ -27,6 +27,9 @@ struct MapIntrinsics {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   double bf = 0;          // baseline × fx; 0 for a monocular camera
   double closeDepth = 0;  // depth below which a stereo keypoint is "close" (40 × baseline)
+  // A depth sensor's σ of the virtual disparity bf/d (px at level 0); 0 for a stereo pair. It
+  // picks the residual BA gives the keypoint's depth (optim/reprojection.hpp).
+  double disparitySigma = 0;
   double minX = 0, maxX = 0, minY = 0, maxY = 0;
 
   bool inImage(double u, double v) const { return u >= minX && u < maxX && v >= minY && v < maxY; }

@@ -88,6 +88,10 @@ class Problem {
   void setActive(ResidualId id, bool active) {
     visitTerm(id.term, [&](auto& records) { records[id.index].active = active; });
   }
+  // The robust kernel's threshold δ² of one residual; infinity turns the kernel off.
+  void setKernelThreshold(ResidualId id, double delta2) {
+    visitTerm(id.term, [&](auto& records) { records[id.index].delta2 = delta2; });
+  }
   bool active(ResidualId id) const {
     bool result = false;
     visitTerm(id.term, [&](const auto& records) { result = records[id.index].active; });

@@ -1,6 +1,6 @@
 // orbis/optim/reprojection.hpp — reprojection residuals of a world point seen by a camera pose,
 // generic over the camera model: 2×6×3 for a pinhole (monocular), 3×6×3 for rectified stereo and
-// RGB-D (uL, v, uR).
+// RGB-D (uL, v, uR), and 3×6×3 for a depth sensor's (uL, v, disparity) (DisparityReprojection).
 //
 // Contract: r = camera.project(T_cw·X_w) − measurement (predicted minus observed; the sign does
 // not change the cost). Jacobians are with respect to the left update exp(δ)·T_cw (SE3Manifold)
@@ -43,6 +43,40 @@ struct Reprojection {
 using MonoReprojection = Reprojection<PinholeCamera<double>>;
 using StereoReprojection = Reprojection<RectifiedStereoCamera<double>>;
 using RgbdReprojection = Reprojection<RgbdCamera<double>>;
+
+// A depth sensor's observation. Its virtual right coordinate uR = uL − bf/d is the measured uL
+// minus a disparity from the sensor, so uR's error is uL's error plus the sensor's: the stereo
+// residual above (uL, v, uR), right for two images matched independently, would count the
+// keypoint's horizontal error twice and give the depth the weight of a second keypoint (σ√2 px
+// of disparity, where a Kinect measures it to a fraction of that). The rows here are the keypoint
+// (uL, v) and its disparity uL − uR whitened by disparityWeight = σ(keypoint) / σ(disparity), so
+// information·‖r‖² is still χ² with 3 degrees of freedom. The measurement is stored as (uL, v, uR)
+// like the stereo one. Camera: any 3-D model projecting to (uL, v, uR).
+template <CameraModel Camera>
+struct DisparityReprojection {
+  static_assert(Camera::kObservationDim == 3, "the disparity residual needs a (uL, v, uR) camera");
+  using PoseManifold = SE3Manifold;
+  static constexpr int kDim = 3;
+  static constexpr bool kHasPoint = true;
+  using Observation = Eigen::Vector3d;
+
+  Observation measurement;
+  const Camera* camera = nullptr;
+  double disparityWeight = 1.0;
+
+  void evaluate(const SE3d& cameraFromWorld, const Eigen::Vector3d& pointWorld, Observation& r,
+                Eigen::Matrix<double, 3, 6>* jPose, Eigen::Matrix<double, 3, 3>* jPoint) const {
+    // The stereo residual, then its third row replaced by w·(row uL − row uR): a linear map, so
+    // the Jacobians follow by the same rows.
+    const Reprojection<Camera> stereo{measurement, camera};
+    stereo.evaluate(cameraFromWorld, pointWorld, r, jPose, jPoint);
+    r(2) = disparityWeight * (r(0) - r(2));
+    if (jPose) jPose->row(2) = disparityWeight * (jPose->row(0) - jPose->row(2));
+    if (jPoint) jPoint->row(2) = disparityWeight * (jPoint->row(0) - jPoint->row(2));
+  }
+};
+
+using DepthReprojection = DisparityReprojection<RectifiedStereoCamera<double>>;
 
 // ORB-SLAM's per-observation information: σ² = scaleFactor^(2·octave), information = 1/σ².
 inline double levelInformation(double scaleFactor, int octave) {

@@ -93,7 +93,14 @@ class SlamCore {
 };
 
 MapIntrinsics makeMapIntrinsics(const PinholeCamera<double>& pinhole, double bf, double closeDepth, int width,
-                                int height);
+                                int height, double disparitySigma = 0.0);
+
+// A depth sensor's disparity σ; 0 for cameras that measure no depth of their own.
+template <class Camera>
+double disparitySigmaOf(const Camera& camera) {
+  if constexpr (requires { camera.disparitySigma; }) return static_cast<double>(camera.disparitySigma);
+  else return 0.0;
+}
 
 template <SensorConfiguration Sensor>
 class Slam {
@@ -106,7 +113,7 @@ class Slam {
       : builder_(camera, orb),
         core_(std::move(vocabulary),
               makeMapIntrinsics(camera.pinhole, camera.bf(), camera.closeDepthThreshold(), camera.pinhole.width,
-                                camera.pinhole.height),
+                                camera.pinhole.height, disparitySigmaOf(camera)),
               Sensor::kDepthFromSensor, options) {}
 
   TrackResult track(const Input& input) {

@@ -47,7 +47,11 @@ struct DatasetOptions {
   double maxDepthDt = 0.02;          // TUM: largest |t_rgb - t_depth| of an associated pair, seconds
   double maxStereoDt = 0.003;        // EuRoC: largest |t_cam0 - t_cam1| of a stereo pair, seconds
   double tumDepthScale = 5000.0;     // TUM: raw depth value / scale = metres (the camera's depthScale)
-  double tumVirtualBaseline = 0.08;  // TUM: metres (the paper's 8 cm for Kinect-type sensors)
+  // TUM: the virtual stereo baseline times fx (pixels x metres). 40 is what ORB-SLAM2's TUM1-3
+  // settings give every Kinect (about 7.5 cm at fx 535), so runs without a settings file match
+  // runs with examples/settings/TUM3.yaml. tumVirtualBaseline (metres), when set, wins.
+  double tumBf = 40.0;
+  std::optional<double> tumVirtualBaseline;
   bool rectify = true;        // EuRoC: deliver rectified images and calibration (what the pipeline eats)
   bool strict = false;        // a missing right image or depth map throws instead of warning
   // A long run should survive a bad frame: a listed left/colour image that does not exist is then
