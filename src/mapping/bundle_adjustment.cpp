@@ -1,73 +1,70 @@
 #include "orbis/mapping/bundle_adjustment.hpp"
 
-#include <limits>
 #include <map>
-#include <memory>
 #include <mutex>
 #include <set>
 #include <vector>
 
-#include "orbis/optim/slam_residuals.hpp"
+#include "orbis/map/map_camera.hpp"
+#include "orbis/optim/slam_ba.hpp"
 
 namespace orbis {
 
 namespace {
 
-using optim::ResidualId;
-using optim::SlamProblem;
-
-struct Observation {
+// Where an observation of the problem came from, to write its verdict back to the map.
+struct ObservationSource {
   KeyFrame* kf;
   MapPoint* point;
   std::size_t keypoint;
-  ResidualId id;
-  int pose, pointIndex;
-  bool threeDof;  // stereo or depth residual: the 3-DOF χ² test
 };
 
-// A BA problem copied out of the map: the keyframes (free or fixed), points and observations.
+// A BA problem copied out of the map as plain values (optim/slam_ba.hpp's input).
 struct BaSnapshot {
-  std::unique_ptr<optim::ObservationCameras> cameras;
-  SlamProblem problem;
-  std::vector<KeyFrame*> keyFrames;  // problem pose index -> keyframe
-  std::vector<MapPoint*> points;     // problem point index -> map point
-  std::vector<Observation> observations;
+  MapIntrinsics intrinsics;
+  std::vector<KeyFrame*> keyFrames;  // pose index -> keyframe
+  std::vector<SE3d> poses;
+  std::vector<char> poseFixed;
+  std::vector<MapPoint*> points;  // point index -> map point
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<optim::SlamObservation> observations;
+  std::vector<ObservationSource> sources;  // per observation
 };
 
 // Builds the problem for `free` keyframes and `points`; keyframes outside `free` that observe the
 // points enter fixed. The origin keyframe is always fixed (gauge). Caller holds the map mutex.
 void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points) {
-  const MapIntrinsics& K = free.front()->intrinsics;
-  s.cameras = std::make_unique<optim::ObservationCameras>(K.fx, K.fy, K.cx, K.cy, K.bf, K.disparitySigma);
+  s.intrinsics = free.front()->intrinsics;
   std::map<KeyFrame*, int, ById> poseOf;
-  for (KeyFrame* kf : free) {
-    poseOf[kf] = s.problem.addPose(kf->Tcw(), kf->id == 0);
+  auto addPose = [&](KeyFrame* kf, bool fixed) {
+    const int index = static_cast<int>(s.poses.size());
     s.keyFrames.push_back(kf);
-  }
+    s.poses.push_back(kf->Tcw());
+    s.poseFixed.push_back(fixed ? 1 : 0);
+    return poseOf.emplace(kf, index).first;
+  };
+  for (KeyFrame* kf : free) addPose(kf, kf->id == 0);
   for (MapPoint* p : points) {
-    const int pi = s.problem.addPoint(p->position());
+    const int pointIndex = static_cast<int>(s.positions.size());
     s.points.push_back(p);
+    s.positions.push_back(p->position());
     for (const auto& [kf, index] : p->observations()) {
       if (kf->isBad()) continue;
       auto it = poseOf.find(kf);
-      if (it == poseOf.end()) {
-        it = poseOf.emplace(kf, s.problem.addPose(kf->Tcw(), true)).first;
-        s.keyFrames.push_back(kf);
-      }
+      if (it == poseOf.end()) it = addPose(kf, true);
       const FrameFeatures& f = kf->features();
       const Keypoint& k = f.keypointsUn[index];
-      const double information = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
-      Observation o{kf, p, index, {}, it->second, pi, false};
-      o.id = s.cameras->add(s.problem, it->second, pi, k.u, k.v, f.uRight[index], information, o.threeDof);
-      s.observations.push_back(o);
+      s.observations.push_back({it->second, pointIndex, Eigen::Vector3d(k.u, k.v, f.uRight[index]),
+                                f.scales.invSigma2[static_cast<std::size_t>(k.octave)]});
+      s.sources.push_back({kf, p, index});
     }
   }
 }
 
-bool isOutlier(const BaSnapshot& s, const Observation& o) {
-  const double chi2 = s.problem.chi2(o.id);
-  if (chi2 > (o.threeDof ? optim::kChi2Stereo : optim::kChi2Mono)) return true;
-  return (s.problem.pose(o.pose) * s.problem.point(o.pointIndex)).z() <= 0;
+optim::BundleAdjustmentResult solve(BaSnapshot& s, const optim::BundleAdjustmentOptions& options) {
+  return visitCamera(s.intrinsics, [&](const auto& camera) {
+    return optim::bundleAdjustment(camera, s.poses, s.poseFixed, s.positions, s.observations, options);
+  });
 }
 
 }  // namespace
@@ -93,24 +90,19 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::at
     stats.observations = static_cast<int>(s.observations.size());
   }
   if (s.observations.empty()) return stats;
-  optim::SolverOptions options;
-  options.maxIterations = 5;
+  // ORB-SLAM's LocalBundleAdjustment: 5 robust iterations, then 10 without the outliers and
+  // without the kernel.
+  optim::BundleAdjustmentOptions options;
+  options.iterations = 5;
+  options.refineIterations = 10;
   options.abortFlag = abort;
-  s.problem.solve(options);
-  if (abort && abort->load()) {
-    stats.aborted = true;
-  } else {
-    // Second pass without the outliers and without the kernel (ORB-SLAM's LocalBundleAdjustment).
-    for (const Observation& o : s.observations) {
-      if (isOutlier(s, o)) s.problem.setActive(o.id, false);
-      s.problem.setKernelThreshold(o.id, std::numeric_limits<double>::infinity());
-    }
-    options.maxIterations = 10;
-    s.problem.solve(options);
-  }
+  const optim::BundleAdjustmentResult result = solve(s, options);
+  stats.aborted = result.robustPass.termination == optim::Termination::Aborted;
+
   std::lock_guard lock(map.mutex());
-  for (const Observation& o : s.observations) {
-    if (!isOutlier(s, o)) continue;
+  for (std::size_t k = 0; k < s.observations.size(); ++k) {
+    if (!result.outlier[k]) continue;
+    const ObservationSource& o = s.sources[k];
     if (o.point->isBad() || o.kf->isBad() || o.kf->point(o.keypoint) != o.point) continue;
     o.kf->erasePoint(o.keypoint);
     o.point->eraseObservation(o.kf);
@@ -118,12 +110,12 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::at
   }
   for (std::size_t i = 0; i < s.keyFrames.size(); ++i) {
     KeyFrame* k = s.keyFrames[i];
-    if (!s.problem.poseFixed(static_cast<int>(i)) && !k->isBad()) k->setPose(s.problem.pose(static_cast<int>(i)));
+    if (!s.poseFixed[i] && !k->isBad()) k->setPose(s.poses[i]);
   }
   for (std::size_t i = 0; i < s.points.size(); ++i) {
     MapPoint* p = s.points[i];
     if (p->isBad()) continue;
-    p->setPosition(s.problem.point(static_cast<int>(i)));
+    p->setPosition(s.positions[i]);
     p->updateNormalAndDepth();
   }
   return stats;
@@ -138,13 +130,15 @@ FullBundleAdjustmentResult fullBundleAdjustment(Map& map, int iterations, std::a
     if (keyFrames.empty()) return result;
     buildSnapshot(s, keyFrames, map.mapPoints());
   }
-  optim::SolverOptions options;
-  options.maxIterations = iterations;
+  // Huber throughout, no outlier pass: the loop closer merges the result through the spanning tree.
+  optim::BundleAdjustmentOptions options;
+  options.iterations = iterations;
+  options.refineIterations = 0;
   options.abortFlag = abort;
-  s.problem.solve(options);
-  result.aborted = abort && abort->load();
-  for (std::size_t i = 0; i < s.keyFrames.size(); ++i) result.keyFramePoses[s.keyFrames[i]->id] = s.problem.pose(static_cast<int>(i));
-  for (std::size_t i = 0; i < s.points.size(); ++i) result.pointPositions[s.points[i]->id] = s.problem.point(static_cast<int>(i));
+  const optim::BundleAdjustmentResult solved = solve(s, options);
+  result.aborted = solved.robustPass.termination == optim::Termination::Aborted || (abort && abort->load());
+  for (std::size_t i = 0; i < s.keyFrames.size(); ++i) result.keyFramePoses[s.keyFrames[i]->id] = s.poses[i];
+  for (std::size_t i = 0; i < s.points.size(); ++i) result.pointPositions[s.points[i]->id] = s.positions[i];
   return result;
 }
 

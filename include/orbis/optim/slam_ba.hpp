@@ -3,8 +3,11 @@
 //
 // Contract: inputs are plain values — poses are camera-from-world SE3d, observations carry the
 // measurement (uL, v, uR) with uR < 0 meaning "monocular" (ORB-SLAM's convention) and their
-// information 1/σ² (see levelInformation). Camera is the sensor's model: PinholeCamera (every
-// observation monocular) or a stereo/RGB-D model (monocular observations then use its pinhole).
+// information 1/σ² (see levelInformation). Camera is the sensor's model, and picks the residual
+// at compile time: PinholeCamera (every observation monocular), RectifiedStereoCamera (ORB-SLAM's
+// (uL, v, uR) residual) or RgbdCamera (the depth reading as a whitened disparity,
+// DisparityReprojection, weighted by 1 / camera.disparitySigma, which must be positive);
+// monocular observations of a 3-D model use its pinhole.
 // Huber thresholds are the χ² 95% quantiles (5.991 mono, 7.815 stereo). Observations whose χ²
 // exceeds them after the robust pass, or whose point is behind the camera, are reported as
 // outliers, as ORB-SLAM classifies them. Nothing here throws (except writing the optional BAL
@@ -34,9 +37,12 @@ struct SlamObservation {
 struct MotionOnlyOptions {
   int rounds = 4;
   int iterationsPerRound = 10;
-  int robustRounds = 2;  // Huber in the first rounds only, as ORB-SLAM
+  int robustRounds = 3;  // Huber in the first three rounds, the last one without (ORB-SLAM2)
+  // Each round starts again from the prior pose, with the inliers of the round before (ORB-SLAM2):
+  // a round that outliers dragged off does not hand its pose on.
   double chi2Mono = kChi2Mono;
   double chi2Stereo = kChi2Stereo;
+  bool restartEachRound = true;
 };
 
 struct MotionOnlyResult {
@@ -62,11 +68,23 @@ struct BundleAdjustmentResult {
   SolverSummary refinePass;
 };
 
-// The problem type a camera model needs: a monocular term, plus a stereo term for metric cameras.
+// The residual of a camera model's 3-D observations: ORB-SLAM's (uL, v, uR) for a stereo pair,
+// the whitened disparity for a depth sensor (its uR is uL minus the sensor's disparity).
+template <CameraModel Camera>
+struct DepthResidualFor {
+  using type = Reprojection<Camera>;
+};
+template <>
+struct DepthResidualFor<RgbdCamera<double>> {
+  using type = DisparityReprojection<RgbdCamera<double>>;
+};
+template <CameraModel Camera>
+using DepthResidual = typename DepthResidualFor<Camera>::type;
+
+// The problem type a camera model needs: a monocular term, plus a 3-D term for metric cameras.
 template <CameraModel Camera>
 struct SlamProblemFor {
-  using type = Problem<SE3Manifold, Term<MonoReprojection, HuberKernel>,
-                       Term<Reprojection<Camera>, HuberKernel>>;
+  using type = Problem<SE3Manifold, Term<MonoReprojection, HuberKernel>, Term<DepthResidual<Camera>, HuberKernel>>;
 };
 template <>
 struct SlamProblemFor<PinholeCamera<double>> {
@@ -92,8 +110,13 @@ ResidualId addObservation(SlamProblem<Camera>& problem, const Camera& camera,
                           const SlamObservation& o, double chi2Mono, double chi2Stereo) {
   if constexpr (Camera::kObservationDim == 3) {
     if (o.isStereo()) {
-      return problem.add(Reprojection<Camera>{o.measurement, &camera}, o.pose, o.point,
-                         o.information, chi2Stereo);
+      using R = DepthResidual<Camera>;
+      if constexpr (requires { R::disparityWeight; }) {
+        return problem.add(R{o.measurement, &camera, 1.0 / camera.disparitySigma}, o.pose, o.point, o.information,
+                           chi2Stereo);
+      } else {
+        return problem.add(R{o.measurement, &camera}, o.pose, o.point, o.information, chi2Stereo);
+      }
     }
   }
   return problem.add(MonoReprojection{o.measurement.head<2>(), &pinholeOf(camera)}, o.pose, o.point,
@@ -127,7 +150,8 @@ bool isOutlier(const P& problem, ResidualId id, const SlamObservation& o, double
 
 // Motion-only BA (tracking): the pose moves, the points stay. Four rounds of ten iterations;
 // after each round every observation is re-classified (outliers can come back), and only the
-// inliers take part in the next round. Each round continues from the previous round's pose.
+// inliers take part in the next round, which starts again from the prior pose (or continues,
+// without restartEachRound).
 template <CameraModel Camera>
 MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFromWorld,
                                             std::span<const Eigen::Vector3d> pointsWorld,
@@ -148,8 +172,10 @@ MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFr
   SolverOptions solver;
   solver.maxIterations = options.iterationsPerRound;
   solver.linearSolver = LinearSolverKind::DenseCholesky;
+  const SE3d prior = cameraFromWorld;
   for (int round = 0; round < options.rounds; ++round) {
     if (round == options.robustRounds) slam_detail::removeKernels(problem);
+    if (options.restartEachRound) problem.setPose(0, prior);
     result.lastRound = problem.solve(solver);
     result.inliers = 0;
     for (std::size_t k = 0; k < observations.size(); ++k) {
