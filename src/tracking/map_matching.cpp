@@ -193,8 +193,8 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
   const FrameFeatures& f2 = kf2.features();
   // Epipole of kf1's centre in kf2: keypoints too close to it have unreliable depth.
   const Eigen::Vector3d c1in2 = kf2.Tcw() * kf1.cameraCenter();
-  const double ex = kf2.intrinsics.fx * c1in2.x() / c1in2.z() + kf2.intrinsics.cx;
-  const double ey = kf2.intrinsics.fy * c1in2.y() / c1in2.z() + kf2.intrinsics.cy;
+  const Eigen::Vector2d epipole(kf2.intrinsics.fx * c1in2.x() / c1in2.z() + kf2.intrinsics.cx,
+                                kf2.intrinsics.fy * c1in2.y() / c1in2.z() + kf2.intrinsics.cy);
   std::vector<long> matched2(kf2.size(), -1);
   std::vector<long> matched1(kf1.size(), -1);
   RotationHistogram hist;
@@ -207,32 +207,12 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
     if (nodeB < nodeA) { ++ib; continue; }
     for (std::uint32_t i : a.featuresOf(ia)) {
       if (kf1.point(i)) continue;
-      const bool stereo1 = f1.uRight[i] >= 0;
-      if (onlyStereo && !stereo1) continue;
       const Keypoint& k1 = f1.keypointsUn[i];
-      // x2ᵀ F12 x1 = 0, so the epipolar line of x1 in kf2 is F12 x1.
+      // x2ᵀ F12 x1 = 0, so the epipolar line of x1 in kf2 is F12 x1; candidates share the node.
       const Eigen::Vector3d line = F12 * Eigen::Vector3d(k1.u, k1.v, 1.0);
-      int bestDist = kThLow;
-      long best = -1;
-      for (std::uint32_t j : b.featuresOf(ib)) {
-        if (kf2.point(j) || matched2[j] >= 0) continue;
-        const bool stereo2 = f2.uRight[j] >= 0;
-        if (onlyStereo && !stereo2) continue;
-        const int d = hammingDistance(f1.descriptors[i], f2.descriptors[j]);
-        if (d > kThLow || d > bestDist) continue;
-        const Keypoint& k2 = f2.keypointsUn[j];
-        if (!stereo1 && !stereo2) {
-          const double dx = ex - k2.u, dy = ey - k2.v;
-          if (dx * dx + dy * dy < 100 * f2.scales.scale[static_cast<std::size_t>(k2.octave)]) continue;
-        }
-        const double num = line.x() * k2.u + line.y() * k2.v + line.z();
-        const double den = line.x() * line.x() + line.y() * line.y();
-        if (den == 0) continue;
-        if (num * num / den < 3.84 * f2.scales.sigma2[static_cast<std::size_t>(k2.octave)]) {
-          best = j;
-          bestDist = d;
-        }
-      }
+      const long best = detail::bestEpipolarPartner(
+          f1, i, f2, b.featuresOf(ib), line, epipole, onlyStereo,
+          [&](std::size_t j) { return kf2.point(j) != nullptr || matched2[j] >= 0; }, HammingDistance{});
       if (best >= 0) {
         matched2[static_cast<std::size_t>(best)] = i;
         matched1[i] = best;

@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <ranges>
 #include <span>
 #include <utility>
 #include <vector>
@@ -46,7 +47,7 @@ inline constexpr int kThLow = 50;
 inline constexpr float kRatioLoose = 0.9f;
 inline constexpr float kRatioStrict = 0.75f;
 // Chi-square 95% quantile, 1 degree of freedom: the epipolar-line test.
-inline constexpr float kEpipolarChi2 = 3.84f;
+inline constexpr double kEpipolarChi2 = 3.84;
 }  // namespace matching
 
 template <class D>
@@ -80,6 +81,44 @@ inline std::vector<std::uint8_t> takenMask(std::span<const std::uint8_t> taken, 
   std::copy_n(taken.begin(), std::min(n, taken.size()), mask.begin());
   return mask;
 }
+
+// ORB-SLAM's SearchForTriangulation test for keypoint i1 of f1, whose epipolar line in image 2
+// is `line`: the best of `candidates` (keypoint indices of f2, `skip` ones left out) by
+// descriptor distance, at most kThLow with ties going to the later candidate (as ORB-SLAM),
+// within χ² 3.84·σ² of the line, and, when neither keypoint has depth, away from the epipole
+// (no parallax there). -1 when none qualifies.
+template <class Candidates, class Skip, class Distance>
+long bestEpipolarPartner(const FrameFeatures& f1, std::size_t i1, const FrameFeatures& f2,
+                         const Candidates& candidates, const Eigen::Vector3d& line,
+                         const Eigen::Vector2d& epipole2, bool onlyStereo, Skip&& skip, const Distance& distance) {
+  const double lineNorm2 = line.x() * line.x() + line.y() * line.y();
+  if (!(lineNorm2 > 0)) return -1;
+  const bool stereo1 = f1.uRight[i1] >= 0.f;
+  if (onlyStereo && !stereo1) return -1;
+  int bestDist = matching::kThLow;
+  long best = -1;
+  for (const auto candidate : candidates) {
+    const auto i2 = static_cast<std::size_t>(candidate);
+    if (skip(i2)) continue;
+    const bool stereo2 = f2.uRight[i2] >= 0.f;
+    if (onlyStereo && !stereo2) continue;
+    const int d = distance(f1.descriptors[i1], f2.descriptors[i2]);
+    if (d > bestDist) continue;
+    const Keypoint& k2 = f2.keypointsUn[i2];
+    const auto level2 = static_cast<std::size_t>(k2.octave);
+    if (!stereo1 && !stereo2) {
+      const double ex = epipole2.x() - k2.u, ey = epipole2.y() - k2.v;
+      if (ex * ex + ey * ey < 100 * f2.scales.scale[level2]) continue;
+    }
+    const double num = line.x() * k2.u + line.y() * k2.v + line.z();
+    if (num * num / lineNorm2 < matching::kEpipolarChi2 * f2.scales.sigma2[level2]) {
+      best = static_cast<long>(i2);
+      bestDist = d;
+    }
+  }
+  return best;
+}
+
 }  // namespace detail
 
 // matches[q] = keypoint index or -1; `taken` marks keypoints already matched (may be empty).
@@ -252,40 +291,20 @@ int searchForTriangulation(const FrameFeatures& f1, const FrameFeatures& f2, con
                            const Eigen::Vector2f& epipole2, const EpipolarSearchOptions& options,
                            std::vector<std::pair<int, int>>& pairs, const Distance& distance = {}) {
   pairs.clear();
-  const Eigen::Matrix3f F21 = F21d.cast<float>();
   const std::vector<std::uint8_t> taken1 = detail::takenMask(options.taken1, f1.size());
   std::vector<std::uint8_t> taken2 = detail::takenMask(options.taken2, f2.size());
   const bool grouped = !options.group1.empty() && !options.group2.empty();
+  const Eigen::Vector2d epipole = epipole2.cast<double>();
   RotationHistogram histogram;
   for (std::size_t i1 = 0; i1 < f1.size(); ++i1) {
     if (taken1[i1]) continue;
-    const bool stereo1 = f1.uRight[i1] >= 0.f;
-    if (options.onlyStereo && !stereo1) continue;
     const Keypoint& k1 = f1.keypointsUn[i1];
-    // The epipolar line of k1 in image 2.
-    const Eigen::Vector3f line = F21 * Eigen::Vector3f(k1.u, k1.v, 1.f);
-    const float lineNorm2 = line.x() * line.x() + line.y() * line.y();
-    if (!(lineNorm2 > 0.f)) continue;
-    int best = matching::kThLow + 1, bestIdx = -1;
-    for (std::size_t i2 = 0; i2 < f2.size(); ++i2) {
-      if (taken2[i2]) continue;
-      if (grouped && options.group1[i1] != options.group2[i2]) continue;
-      const bool stereo2 = f2.uRight[i2] >= 0.f;
-      if (options.onlyStereo && !stereo2) continue;
-      const int d = distance(f1.descriptors[i1], f2.descriptors[i2]);
-      if (d >= best) continue;
-      const Keypoint& k2 = f2.keypointsUn[i2];
-      const auto level2 = static_cast<std::size_t>(k2.octave);
-      if (!stereo1 && !stereo2) {
-        // Near the epipole a monocular pair has almost no parallax to triangulate from.
-        const float ex = epipole2.x() - k2.u, ey = epipole2.y() - k2.v;
-        if (ex * ex + ey * ey < 100.f * f2.scales.scale[level2]) continue;
-      }
-      const float num = line.x() * k2.u + line.y() * k2.v + line.z();
-      if (num * num / lineNorm2 >= matching::kEpipolarChi2 * f2.scales.sigma2[level2]) continue;
-      best = d;
-      bestIdx = static_cast<int>(i2);
-    }
+    // The epipolar line of k1 in image 2; every keypoint of f2 is a candidate.
+    const Eigen::Vector3d line = F21d * Eigen::Vector3d(k1.u, k1.v, 1.0);
+    const auto skip = [&](std::size_t i2) { return taken2[i2] || (grouped && options.group1[i1] != options.group2[i2]); };
+    const long best = detail::bestEpipolarPartner(f1, i1, f2, std::views::iota(std::size_t{0}, f2.size()), line,
+                                                  epipole, options.onlyStereo, skip, distance);
+    const int bestIdx = static_cast<int>(best);
     if (bestIdx < 0) continue;
     taken2[static_cast<std::size_t>(bestIdx)] = 1;
     if (options.checkOrientation)
