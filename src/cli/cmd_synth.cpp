@@ -44,6 +44,7 @@ int runSynth(const std::vector<std::string>& args) {
       .option("--baseline", "B", "stereo baseline in metres (also the RGB-D virtual baseline)", "0.1")
       .option("--fps", "HZ", "frame rate", "30")
       .option("--noise", "SIGMA", "Gaussian image noise, grey levels", "0")
+      .option("--depth-noise", "SIGMA", "Gaussian noise of the depth's inverse, 1/m (Kinect-like: 0.0014)", "0")
       .option("--blur", "N", "motion blur: sub-frames averaged per frame (1 = none)", "1")
       .option("--black", "START:COUNT", "black out COUNT frames from frame START (relocalisation tests)")
       .option("--seed", "S", "seed of the scene, textures and noise", "1")
@@ -67,6 +68,7 @@ int runSynth(const std::vector<std::string>& args) {
   o.baseline = p.getDouble("--baseline");
   o.fps = p.getDouble("--fps");
   o.noiseSigma = p.getDouble("--noise");
+  o.depthNoise = p.getDouble("--depth-noise");
   o.blurSubframes = positiveInt("--blur");
   o.supersample = positiveInt("--supersample");
   o.threads = positiveInt("--threads");

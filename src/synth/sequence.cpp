@@ -25,6 +25,7 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
   require(options.baseline > 0.0, "baseline", "must be positive (metres)");
   require(options.fps > 0.0, "fps", "must be positive");
   require(options.noiseSigma >= 0.0, "noise", "must not be negative");
+  require(options.depthNoise >= 0.0, "depth noise", "must not be negative");
   require(options.blurSubframes >= 1, "blur", "must be at least 1 sub-frame");
   require(options.shutter >= 0.0 && options.shutter <= 1.0, "shutter", "must lie in [0, 1]");
   require(options.blackCount >= 0, "black", "count must not be negative");
@@ -104,6 +105,18 @@ SynthFrame SyntheticSequence::render(int i, bool withRight, bool withDepth) {
     return f;
   }
   f.left = renderImage(i, SE3d(), 0, withDepth ? &f.depth : nullptr);
+  if (withDepth && options_.depthNoise > 0.0) {
+    // Noise on inverse depth (the sensor's disparity), its own stream so images stay unchanged.
+    SynthRng rng(mixSeed(options_.seed, static_cast<std::uint64_t>(i) + 1, 1000));
+    for (int y = 0; y < f.depth.rows; ++y) {
+      float* d = f.depth.ptr<float>(y);
+      for (int x = 0; x < f.depth.cols; ++x) {
+        if (d[x] <= 0.f) continue;
+        const double inverse = 1.0 / d[x] + options_.depthNoise * rng.normal();
+        d[x] = inverse > 0.0 ? static_cast<float>(1.0 / inverse) : 0.f;
+      }
+    }
+  }
   if (withRight)
     f.right = renderImage(i, SE3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(options_.baseline, 0.0, 0.0)), 1, nullptr);
   return f;

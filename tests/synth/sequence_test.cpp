@@ -151,6 +151,32 @@ TEST(SynthSequence, NoiseHasTheRequestedSigma) {
   EXPECT_NEAR(mean[0], 0.0, 0.1);
 }
 
+TEST(SynthSequence, DepthNoiseIsOnTheInverseAndLeavesImagesAlone) {
+  SynthOptions clean = smallOptions();
+  SynthOptions noisy = clean;
+  noisy.depthNoise = 0.01;  // 1/m
+  const SynthFrame a = SyntheticSequence(clean).render(5, false, true);
+  const SynthFrame b = SyntheticSequence(noisy).render(5, false, true);
+  EXPECT_EQ(cv::norm(a.left, b.left, cv::NORM_INF), 0.0);
+  double sum = 0, sum2 = 0;
+  int n = 0;
+  for (int y = 0; y < a.depth.rows; ++y)
+    for (int x = 0; x < a.depth.cols; ++x) {
+      const float da = a.depth.at<float>(y, x), db = b.depth.at<float>(y, x);
+      if (da <= 0.f || db <= 0.f) continue;
+      const double e = 1.0 / db - 1.0 / da;
+      sum += e;
+      sum2 += e * e;
+      ++n;
+    }
+  ASSERT_GT(n, 1000);
+  const double mean = sum / n, sigma = std::sqrt(sum2 / n - mean * mean);
+  std::printf("[synth] depth noise: inverse-depth error mean %.2e, sigma %.5f 1/m over %d pixels\n", mean, sigma, n);
+  EXPECT_NEAR(sigma, 0.01, 0.0005);
+  EXPECT_NEAR(mean, 0.0, 0.0005);
+  EXPECT_EQ(cv::norm(b.depth, SyntheticSequence(noisy).render(5, false, true).depth, cv::NORM_INF), 0.0);  // same seed, same noise
+}
+
 TEST(SynthSequence, MotionBlurSmoothsAlongTheMotion) {
   SynthOptions sharp = smallOptions();
   sharp.frames = 300;  // the default pace: about 4 cm and 1.2 degrees per frame

@@ -22,6 +22,7 @@ synth::SynthOptions smallLoop(std::uint64_t seed) {
   synth::SynthOptions o;
   o.frames = 150;
   o.noiseSigma = 2.0;
+  o.depthNoise = 0.0014;  // Kinect-like (RGB-D runs only read depth)
   o.seed = seed;
   o.threads = 2;
   return o;

@@ -8,8 +8,8 @@
 // metric along the left optical axis. Images are CV_8UC1: the rendered grey levels, averaged
 // over blurSubframes renders spread over `shutter` of the frame interval centred on the
 // frame's instant (motion blur), plus Gaussian noise of noiseSigma grey levels, rounded and
-// clamped. Frames blackStart .. blackStart+blackCount-1 are all black with zero (invalid)
-// depth, but keep their pose (the camera was covered). Everything is a function of the
+// clamped; depth gets Gaussian noise of depthNoise on its inverse. Frames blackStart ..
+// blackStart+blackCount-1 are all black with zero (invalid) depth, but keep their pose (the camera was covered). Everything is a function of the
 // options and the seed: the same options give byte-identical frames, in any order (render()
 // changes nothing but its renderer's scratch buffers; use one sequence object per thread).
 #pragma once
@@ -36,6 +36,9 @@ struct SynthOptions {
   double fps = 30.0;
   double startTime = 1.0;        // seconds, timestamp of frame 0
   double noiseSigma = 0.0;       // grey levels
+  // Depth-sensor noise: σ of inverse depth, 1/m, per pixel, as a structured-light sensor measures
+  // disparity (a Kinect's σ_z ≈ 1.4e-3 z², i.e. about 0.0014 here). 0: exact depth.
+  double depthNoise = 0.0;
   int blurSubframes = 1;         // 1: no motion blur
   double shutter = 0.5;          // fraction of the frame interval the shutter is open
   int blackStart = -1, blackCount = 0;
