@@ -100,7 +100,8 @@ class TumRgbdReader final : public DatasetReader {
     if (sensor_ == SensorKind::Monocular) return *pinhole;
     // Frames carry the raw 16-bit depth; the camera says how it becomes metres.
     const double baseline = options_.tumVirtualBaseline.value_or(options_.tumBf / pinhole->fx);
-    return RgbdCamera<double>(*pinhole, baseline, options_.tumDepthScale);
+    const double depthScale = options_.tumDepthScale.value_or(freiburg_ == 2 ? 5208.0 : 5000.0);
+    return RgbdCamera<double>(*pinhole, baseline, depthScale);
   }
 
   RadTanDistortion<double> distortion() const override {

@@ -40,8 +40,9 @@ class CorruptInputs : public ::testing::Test {
   }
 
   // A three-frame TUM sequence; depth listed for all three.
-  void makeTum() {
-    std::string rgb = "# color images\n# file: 'rgbd_dataset_freiburg3_test.bag'\n", depth = "# depth\n";
+  void makeTum(int freiburg = 3) {
+    std::string rgb = "# color images\n# file: 'rgbd_dataset_freiburg" + std::to_string(freiburg) + "_test.bag'\n",
+                depth = "# depth\n";
     for (int i = 0; i < 3; ++i) {
       const std::string t = "100." + std::to_string(i) + "00000";
       rgb += t + " rgb/" + t + ".png\n";
@@ -90,6 +91,19 @@ TEST_F(CorruptInputs, IntactTumSequenceReadsCleanly) {
   EXPECT_EQ(f.depth.at<std::uint16_t>(0, 0), 5000);
   EXPECT_EQ(std::get<orbis::RgbdCamera<double>>(reader->camera()).metricDepth(5000.0), 1.0);
   EXPECT_EQ(reader->groundTruth().size(), 2u);
+}
+
+// The Kinect comes from the list's header: its intrinsics, ORB-SLAM2's virtual bf of 40, and its
+// depth factor (freiburg2's Kinect reads ~4 % long; ORB-SLAM2's TUM2.yaml uses 5208).
+TEST_F(CorruptInputs, TumCameraFollowsTheKinect) {
+  for (const int freiburg : {1, 2, 3}) {
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    makeTum(freiburg);
+    const auto camera = std::get<orbis::RgbdCamera<double>>(orbis::openTumRgbd(root_, {})->camera());
+    EXPECT_NEAR(camera.bf(), 40.0, 1e-9) << "freiburg" << freiburg;
+    EXPECT_DOUBLE_EQ(camera.depthScale, freiburg == 2 ? 5208.0 : 5000.0) << "freiburg" << freiburg;
+  }
 }
 
 TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {

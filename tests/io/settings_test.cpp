@@ -87,6 +87,11 @@ TEST(Settings, TumFilesAreRgbdWithVirtualBaseline) {
   EXPECT_DOUBLE_EQ(std::get<PinholeCamera<double>>(mono.camera).fx, 517.306408);
 }
 
+TEST(Settings, Tum2CorrectsTheKinectDepthScale) {
+  const Settings s = Settings::load(settingsDir() / "TUM2.yaml");
+  EXPECT_DOUBLE_EQ(std::get<RgbdCamera<double>>(s.camera).depthScale, 5208.0);  // as ORB-SLAM2's TUM2.yaml
+}
+
 TEST(Settings, KittiIsStereoWithThDepthThreshold) {
   const Settings s = Settings::load(settingsDir() / "KITTI04-12.yaml");
   ASSERT_EQ(s.sensor, SensorKind::Stereo);

@@ -46,7 +46,9 @@ struct DatasetOptions {
   std::optional<SensorKind> sensor;
   double maxDepthDt = 0.02;          // TUM: largest |t_rgb - t_depth| of an associated pair, seconds
   double maxStereoDt = 0.003;        // EuRoC: largest |t_cam0 - t_cam1| of a stereo pair, seconds
-  double tumDepthScale = 5000.0;     // TUM: raw depth value / scale = metres (the camera's depthScale)
+  // TUM: raw depth value / scale = metres (the camera's depthScale). Empty: ORB-SLAM2's TUM1-3
+  // settings, 5000 (the PNGs' factor), or 5208 for freiburg2, whose Kinect reads ~4 % long.
+  std::optional<double> tumDepthScale;
   // TUM: the virtual stereo baseline times fx (pixels x metres). 40 is what ORB-SLAM2's TUM1-3
   // settings give every Kinect (about 7.5 cm at fx 535), so runs without a settings file match
   // runs with examples/settings/TUM3.yaml. tumVirtualBaseline (metres), when set, wins.
