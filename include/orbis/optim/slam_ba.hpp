@@ -71,20 +71,20 @@ struct BundleAdjustmentResult {
 // The residual of a camera model's 3-D observations: ORB-SLAM's (uL, v, uR) for a stereo pair,
 // the whitened disparity for a depth sensor (its uR is uL minus the sensor's disparity).
 template <CameraModel Camera>
-struct DepthResidualFor {
+struct MetricResidualFor {
   using type = Reprojection<Camera>;
 };
 template <>
-struct DepthResidualFor<RgbdCamera<double>> {
+struct MetricResidualFor<RgbdCamera<double>> {
   using type = DisparityReprojection<RgbdCamera<double>>;
 };
 template <CameraModel Camera>
-using DepthResidual = typename DepthResidualFor<Camera>::type;
+using MetricResidual = typename MetricResidualFor<Camera>::type;
 
 // The problem type a camera model needs: a monocular term, plus a 3-D term for metric cameras.
 template <CameraModel Camera>
 struct SlamProblemFor {
-  using type = Problem<SE3Manifold, Term<MonoReprojection, HuberKernel>, Term<DepthResidual<Camera>, HuberKernel>>;
+  using type = Problem<SE3Manifold, Term<MonoReprojection, HuberKernel>, Term<MetricResidual<Camera>, HuberKernel>>;
 };
 template <>
 struct SlamProblemFor<PinholeCamera<double>> {
@@ -110,7 +110,7 @@ ResidualId addObservation(SlamProblem<Camera>& problem, const Camera& camera,
                           const SlamObservation& o, double chi2Mono, double chi2Stereo) {
   if constexpr (Camera::kObservationDim == 3) {
     if (o.isStereo()) {
-      using R = DepthResidual<Camera>;
+      using R = MetricResidual<Camera>;
       if constexpr (requires { R::disparityWeight; }) {
         return problem.add(R{o.measurement, &camera, 1.0 / camera.disparitySigma}, o.pose, o.point, o.information,
                            chi2Stereo);
