@@ -1,6 +1,8 @@
 // Stereo keypoint matching on rectified pairs; see include/orbis/features/stereo_matcher.hpp.
 #include "orbis/features/stereo_matcher.hpp"
 
+#include "orbis/features/image_pyramid.hpp"
+
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -54,11 +56,6 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
   const float minDisparity = 0.f;
   const float maxDisparity = bf / minDepth;
   costAndIndex_.clear();
-  // Level <-> level-0 coordinates, per level and image (depends on the level sizes only).
-  levelMapsLeft_.clear();
-  levelMapsRight_.clear();
-  for (const cv::Mat& level : left.pyramid) levelMapsLeft_.push_back(PyramidLevelMap::between(left.pyramid[0], level));
-  for (const cv::Mat& level : right.pyramid) levelMapsRight_.push_back(PyramidLevelMap::between(right.pyramid[0], level));
 
   for (std::size_t iL = 0; iL < n; ++iL) {
     const Keypoint& kl = left.keypoints[iL];
@@ -87,8 +84,9 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
     // Sub-pixel refinement by patch correlation on the left keypoint's level.
     const cv::Mat& imL = left.pyramid[static_cast<std::size_t>(level)];
     const cv::Mat& imR = right.pyramid[static_cast<std::size_t>(level)];
-    const PyramidLevelMap& mapL = levelMapsLeft_[static_cast<std::size_t>(level)];
-    const PyramidLevelMap& mapR = levelMapsRight_[static_cast<std::size_t>(level)];
+    // Level <-> level-0 coordinates (two divisions: nothing beside the 11-position SAD below).
+    const PyramidLevelMap mapL = PyramidLevelMap::between(left.pyramid[0], imL);
+    const PyramidLevelMap mapR = PyramidLevelMap::between(right.pyramid[0], imR);
     const int uL = cvRound(mapL.fromBaseX(kl.u)), vL = cvRound(mapL.fromBaseY(kl.v));
     const int uR0 = cvRound(mapR.fromBaseX(right.keypoints[static_cast<std::size_t>(bestRight)].u));
     if (uR0 - kSlide - kPatchHalf < 0 || uR0 + kSlide + kPatchHalf >= imR.cols) continue;

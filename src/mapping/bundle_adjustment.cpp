@@ -12,13 +12,6 @@ namespace orbis {
 
 namespace {
 
-// Where an observation of the problem came from, to write its verdict back to the map.
-struct ObservationSource {
-  KeyFrame* kf;
-  MapPoint* point;
-  std::size_t keypoint;
-};
-
 // A BA problem copied out of the map as plain values (optim/slam_ba.hpp's input).
 struct BaSnapshot {
   MapIntrinsics intrinsics;
@@ -27,8 +20,8 @@ struct BaSnapshot {
   std::vector<char> poseFixed;
   std::vector<MapPoint*> points;  // point index -> map point
   std::vector<Eigen::Vector3d> positions;
-  std::vector<optim::SlamObservation> observations;
-  std::vector<ObservationSource> sources;  // per observation
+  std::vector<optim::SlamObservation> observations;  // keyframe keyFrames[pose] sees points[point]
+  std::vector<std::size_t> keypointOf;               // per observation: the keyframe's keypoint
 };
 
 // Builds the problem for `free` keyframes and `points`; keyframes outside `free` that observe the
@@ -56,7 +49,7 @@ void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std:
       const Keypoint& k = f.keypointsUn[index];
       s.observations.push_back({it->second, pointIndex, Eigen::Vector3d(k.u, k.v, f.uRight[index]),
                                 f.scales.invSigma2[static_cast<std::size_t>(k.octave)]});
-      s.sources.push_back({kf, p, index});
+      s.keypointOf.push_back(index);
     }
   }
 }
@@ -102,10 +95,12 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::at
   std::lock_guard lock(map.mutex());
   for (std::size_t k = 0; k < s.observations.size(); ++k) {
     if (!result.outlier[k]) continue;
-    const ObservationSource& o = s.sources[k];
-    if (o.point->isBad() || o.kf->isBad() || o.kf->point(o.keypoint) != o.point) continue;
-    o.kf->erasePoint(o.keypoint);
-    o.point->eraseObservation(o.kf);
+    KeyFrame* kf = s.keyFrames[static_cast<std::size_t>(s.observations[k].pose)];
+    MapPoint* point = s.points[static_cast<std::size_t>(s.observations[k].point)];
+    const std::size_t keypoint = s.keypointOf[k];
+    if (point->isBad() || kf->isBad() || kf->point(keypoint) != point) continue;
+    kf->erasePoint(keypoint);
+    point->eraseObservation(kf);
     ++stats.outliersRemoved;
   }
   for (std::size_t i = 0; i < s.keyFrames.size(); ++i) {

@@ -195,7 +195,7 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
   const Eigen::Vector3d c1in2 = kf2.Tcw() * kf1.cameraCenter();
   const Eigen::Vector2d epipole(kf2.intrinsics.fx * c1in2.x() / c1in2.z() + kf2.intrinsics.cx,
                                 kf2.intrinsics.fy * c1in2.y() / c1in2.z() + kf2.intrinsics.cy);
-  std::vector<long> matched2(kf2.size(), -1);
+  std::vector<std::uint8_t> taken2(kf2.size(), 0);
   std::vector<long> matched1(kf1.size(), -1);
   RotationHistogram hist;
   const auto& a = kf1.featureVector();
@@ -212,9 +212,9 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
       const Eigen::Vector3d line = F12 * Eigen::Vector3d(k1.u, k1.v, 1.0);
       const long best = detail::bestEpipolarPartner(
           f1, i, f2, b.featuresOf(ib), line, epipole, onlyStereo,
-          [&](std::size_t j) { return kf2.point(j) != nullptr || matched2[j] >= 0; }, HammingDistance{});
+          [&](std::size_t j) { return kf2.point(j) != nullptr || taken2[j]; }, HammingDistance{});
       if (best >= 0) {
-        matched2[static_cast<std::size_t>(best)] = i;
+        taken2[static_cast<std::size_t>(best)] = 1;
         matched1[i] = best;
         hist.add(k1.angle - f2.keypointsUn[static_cast<std::size_t>(best)].angle, static_cast<int>(i));
       }

@@ -20,7 +20,6 @@
 #include <opencv2/core.hpp>
 
 #include "orbis/features/descriptor.hpp"
-#include "orbis/features/image_pyramid.hpp"
 #include "orbis/features/keypoint.hpp"
 
 namespace orbis {
@@ -48,7 +47,6 @@ class StereoMatcher {
  private:
   std::vector<int> rowStart_, rowEntries_, rowFill_;
   std::vector<std::pair<int, int>> costAndIndex_;
-  std::vector<PyramidLevelMap> levelMapsLeft_, levelMapsRight_;  // per level, refilled per pair
 };
 
 }  // namespace orbis

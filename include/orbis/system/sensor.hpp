@@ -44,8 +44,9 @@ concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, cons
 // two extractions run in parallel. rightBudgetFactor scales the right image's feature budget:
 // more right corners give more left keypoints a partner (55% -> 71% of left keypoints on the
 // synthetic room with 3x, tests/features/synthetic_stereo_test.cpp), but in the whole pipeline
-// 3x measured worse (synthetic stereo loop ATE 27.1 mm against 16.2 mm, KITTI 06 56.7 against
-// 45.0 mm) and slower, so the default is ORB-SLAM2's equal budgets.
+// 3x measured worse (benchmarks/eval_accuracy.sh: synthetic stereo loop 37.8 against 29.0 mm
+// closed, 105 against 67 mm open, KITTI 06 56.9 against 53.9 mm) and slower, so the default is
+// ORB-SLAM2's equal budgets.
 struct Stereo {
   using Camera = RectifiedStereoCamera<double>;
   using Input = StereoInput;
