@@ -18,25 +18,55 @@ namespace {
 
 // Intensity centroid of the circular patch (radius kHalfPatch) around `center`; the angle of
 // the vector from the centre to the centroid, in degrees. Integer moments: exact and fast.
-float centroidAngle(const std::uint8_t* center, int step, const std::vector<int>& halfWidth) {
+#if defined(__SSE2__)
+// Each row is read as 32 bytes (u = -16..15) and masked to the circle: the row sum by
+// _mm_sad_epu8 feeds m01, the sum of u * intensity by _mm_madd_epi16 feeds m10. The same
+// integer moments as the scalar form, about four times faster.
+float centroidAngle(const std::uint8_t* center, int step, const OrbExtractor::CircleRowMask* masks) {
+  constexpr int r = OrbExtractor::kHalfPatch;
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i w0 = _mm_setr_epi16(-16, -15, -14, -13, -12, -11, -10, -9);
+  const __m128i w1 = _mm_setr_epi16(-8, -7, -6, -5, -4, -3, -2, -1);
+  const __m128i w2 = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m128i w3 = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+  __m128i m10 = zero;
+  int m01 = 0;
+  for (int v = -r; v <= r; ++v) {
+    const std::uint8_t* row = center + v * step - 16;
+    const OrbExtractor::CircleRowMask& mask = masks[v < 0 ? -v : v];
+    const __m128i lo = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row)),
+                                     _mm_load_si128(reinterpret_cast<const __m128i*>(mask.bytes)));
+    const __m128i hi = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 16)),
+                                     _mm_load_si128(reinterpret_cast<const __m128i*>(mask.bytes + 16)));
+    const __m128i sums = _mm_add_epi64(_mm_sad_epu8(lo, zero), _mm_sad_epu8(hi, zero));
+    m01 += v * (_mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_unpackhi_epi64(sums, sums)));
+    m10 = _mm_add_epi32(m10, _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi8(lo, zero), w0),
+                                           _mm_madd_epi16(_mm_unpackhi_epi8(lo, zero), w1)));
+    m10 = _mm_add_epi32(m10, _mm_add_epi32(_mm_madd_epi16(_mm_unpacklo_epi8(hi, zero), w2),
+                                           _mm_madd_epi16(_mm_unpackhi_epi8(hi, zero), w3)));
+  }
+  m10 = _mm_add_epi32(m10, _mm_shuffle_epi32(m10, _MM_SHUFFLE(1, 0, 3, 2)));
+  m10 = _mm_add_epi32(m10, _mm_shuffle_epi32(m10, _MM_SHUFFLE(2, 3, 0, 1)));
+  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(_mm_cvtsi128_si32(m10)));
+}
+#else
+float centroidAngle(const std::uint8_t* center, int step, const OrbExtractor::CircleRowMask* masks) {
   constexpr int r = OrbExtractor::kHalfPatch;
   int m01 = 0, m10 = 0;
-  for (int u = -r; u <= r; ++u) m10 += u * center[u];
-  for (int v = 1; v <= r; ++v) {
-    // Rows +v and -v together: their difference feeds m01, their sum m10.
-    int rowDifference = 0;
-    const int d = halfWidth[static_cast<std::size_t>(v)];
-    const std::uint8_t* below = center + v * step;
-    const std::uint8_t* above = center - v * step;
-    for (int u = -d; u <= d; ++u) {
-      const int plus = below[u], minus = above[u];
-      rowDifference += plus - minus;
-      m10 += u * (plus + minus);
+  for (int v = -r; v <= r; ++v) {
+    const std::uint8_t* row = center + v * step;
+    const std::uint8_t* mask = masks[v < 0 ? -v : v].bytes + 16;
+    int sum = 0;
+    for (int u = -16; u < 16; ++u) {
+      const int value = mask[u] ? row[u] : 0;
+      sum += value;
+      m10 += u * value;
     }
-    m01 += v * rowDifference;
+    m01 += v * sum;
   }
   return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }
+#endif
 
 // The pattern as floats, one array per coordinate, points 2i and 2i+1 forming test i.
 struct PatternSoA {
@@ -120,6 +150,11 @@ OrbExtractor::OrbExtractor(const OrbParams& params)
     circleHalfWidth_[static_cast<std::size_t>(v)] = v0;
     ++v0;
   }
+  for (int v = 0; v <= r; ++v) {
+    const int d = circleHalfWidth_[static_cast<std::size_t>(v)];
+    for (int u = -16; u < 16; ++u)
+      circleRows_[static_cast<std::size_t>(v)].bytes[u + 16] = (u >= -d && u <= d) ? 0xFF : 0;
+  }
 }
 
 void OrbExtractor::detectCorners(const cv::Mat& level) {
@@ -127,11 +162,20 @@ void OrbExtractor::detectCorners(const cv::Mat& level) {
   const int minX = kEdge, minY = kEdge, maxX = level.cols - kEdge, maxY = level.rows - kEdge;
   if (maxX - minX < kCellSize / 2 || maxY - minY < kCellSize / 2) return;
 
-  // FAST needs 3 pixels of context beyond the area where it reports corners.
+  // FAST needs 3 pixels of context beyond the area where it reports corners. OpenCV's FAST
+  // runs 16 pixels at a time and finishes each row one pixel at a time: a 30 px wide area
+  // costs 2.6x a 33 px one per pixel (EuRoC, measured). So the searched width is widened to
+  // 16k + 1 (into the level's edge margin, which is wider than 16 px, or the neighbouring
+  // cells) and the corners outside the area dropped; only the suppression of corners in the
+  // area's last column can see the extra columns.
   auto fastIn = [&](int x0, int y0, int x1, int y1, int threshold) {
-    cv::FAST(level(cv::Rect(x0 - 3, y0 - 3, x1 - x0 + 6, y1 - y0 + 6)), fast_, threshold, true);
+    const int width = x1 - x0;
+    const int padded = std::min(((width + 14) / 16) * 16 + 1, level.cols - 3 - x0);
+    cv::FAST(level(cv::Rect(x0 - 3, y0 - 3, std::max(padded, width) + 6, y1 - y0 + 6)), fast_, threshold, true);
+    const auto right = static_cast<float>(x1 - x0 + 3);
     for (const cv::KeyPoint& k : fast_)
-      corners_.push_back({k.pt.x + static_cast<float>(x0 - 3), k.pt.y + static_cast<float>(y0 - 3), k.response});
+      if (k.pt.x < right)
+        corners_.push_back({k.pt.x + static_cast<float>(x0 - 3), k.pt.y + static_cast<float>(y0 - 3), k.response});
   };
 
   // One pass over the whole level at the high threshold finds the same corners as per-cell
@@ -178,16 +222,27 @@ void OrbExtractor::detectCorners(const cv::Mat& level) {
 void OrbExtractor::splitNode(const Node& n, Node children[4], int& count) {
   const float halfX = std::ceil((n.x1 - n.x0) / 2.f), halfY = std::ceil((n.y1 - n.y0) / 2.f);
   const float midX = n.x0 + halfX, midY = n.y0 + halfY;
-  auto* first = corners_.data() + n.begin;
-  auto* last = corners_.data() + n.end;
-  auto* midRow = std::partition(first, last, [midY](const Corner& c) { return c.y < midY; });
-  auto* midTop = std::partition(first, midRow, [midX](const Corner& c) { return c.x < midX; });
-  auto* midBottom = std::partition(midRow, last, [midX](const Corner& c) { return c.x < midX; });
-  const auto at = [&](const Corner* p) { return static_cast<int>(p - corners_.data()); };
-  const Node quarters[4] = {{n.x0, n.y0, midX, midY, n.begin, at(midTop)},
-                            {midX, n.y0, n.x1, midY, at(midTop), at(midRow)},
-                            {n.x0, midY, midX, n.y1, at(midRow), at(midBottom)},
-                            {midX, midY, n.x1, n.y1, at(midBottom), n.end}};
+  // A four-way split by counting and scattering: no data-dependent branches, where
+  // std::partition's mispredicted on every corner (their positions are unpredictable). The
+  // order within a node does not matter: distribute() resolves equal scores by position.
+  Corner* first = corners_.data() + n.begin;
+  const auto size = static_cast<std::size_t>(n.end - n.begin);
+  quadrant_.resize(size);
+  int counts[4] = {0, 0, 0, 0};
+  for (std::size_t i = 0; i < size; ++i) {
+    const int q = static_cast<int>(first[i].x >= midX) + 2 * static_cast<int>(first[i].y >= midY);
+    quadrant_[i] = static_cast<std::uint8_t>(q);
+    ++counts[q];
+  }
+  int offsets[4] = {0, counts[0], counts[0] + counts[1], counts[0] + counts[1] + counts[2]};
+  const int begins[4] = {offsets[0], offsets[1], offsets[2], offsets[3]};
+  scratch_.resize(size);
+  for (std::size_t i = 0; i < size; ++i) scratch_[static_cast<std::size_t>(offsets[quadrant_[i]]++)] = first[i];
+  std::copy(scratch_.begin(), scratch_.end(), first);
+  const Node quarters[4] = {{n.x0, n.y0, midX, midY, n.begin + begins[0], n.begin + begins[1]},
+                            {midX, n.y0, n.x1, midY, n.begin + begins[1], n.begin + begins[2]},
+                            {n.x0, midY, midX, n.y1, n.begin + begins[2], n.begin + begins[3]},
+                            {midX, midY, n.x1, n.y1, n.begin + begins[3], n.end}};
   count = 0;
   for (const Node& q : quarters)
     if (q.end > q.begin) children[count++] = q;
@@ -257,10 +312,18 @@ void OrbExtractor::distribute(int wanted, float minX, float minY, float maxX, fl
     }
   }
 
+  // The strongest corner of each node. FAST scores are small integers, so ties are common; the
+  // corner nearest the node's centre wins them, which keeps the spread even (the first in
+  // detection order would favour each node's top rows).
   for (const Node& n : nodes_) {
+    const float cx = 0.5f * (n.x0 + n.x1), cy = 0.5f * (n.y0 + n.y1);
+    const auto offCentre = [&](const Corner& c) { return (c.x - cx) * (c.x - cx) + (c.y - cy) * (c.y - cy); };
     int best = n.begin;
-    for (int i = n.begin + 1; i < n.end; ++i)
-      if (corners_[static_cast<std::size_t>(i)].response > corners_[static_cast<std::size_t>(best)].response) best = i;
+    for (int i = n.begin + 1; i < n.end; ++i) {
+      const Corner& c = corners_[static_cast<std::size_t>(i)];
+      const Corner& b = corners_[static_cast<std::size_t>(best)];
+      if (c.response > b.response || (c.response == b.response && offCentre(c) < offCentre(b))) best = i;
+    }
     selected_.push_back(best);
   }
 }
@@ -298,7 +361,7 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
     for (int idx : selected_) {
       const Corner& c = corners_[static_cast<std::size_t>(idx)];
       const int x = cvRound(c.x), y = cvRound(c.y);
-      const float angle = centroidAngle(level.ptr<std::uint8_t>(y) + x, step, circleHalfWidth_);
+      const float angle = centroidAngle(level.ptr<std::uint8_t>(y) + x, step, circleRows_.data());
       OrbDescriptor& d = descriptors.emplace_back();
       briefDescriptor(blurred.ptr<std::uint8_t>(y + b) + x + b, blurStep, angle, d);
       keypoints.push_back({toBase.toBaseX(c.x), toBase.toBaseY(c.y), angle, c.response, l});

@@ -4,14 +4,17 @@
 // Contract: satisfies FeatureExtractor. Per frame: a scale pyramid (OrbParams levels x
 // scaleFactor); a budget per level that falls geometrically with the level; FAST corners at
 // iniThFast over each level, then FAST at minThFast again in every ~30 px cell left empty; a
-// quadtree over each level's corners that keeps the strongest corner per node, so the
-// keypoints cover the whole image; orientation by intensity centroid over a circle of radius
-// 15; 256-bit rotated BRIEF with the standard learned pattern on the level blurred by a 7x7
-// Gaussian (sigma 2). Keypoints are ordered by level. The total may exceed the budget by a
-// few (the quadtree splits four ways) and falls short on images with too few corners.
+// quadtree over each level's corners that keeps the strongest corner per node (of equal
+// scores, the one nearest the node's centre), so the keypoints cover the whole image;
+// orientation by intensity centroid over a circle of radius 15; 256-bit rotated BRIEF with the
+// standard learned pattern on the level blurred by a 7x7 Gaussian (sigma 2). Keypoints are
+// ordered by level. The total may exceed the budget by a few (the quadtree splits four ways)
+// and falls short on images with too few corners.
 // Deterministic; not thread-safe (one extractor per image stream: buffers are reused).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -37,6 +40,11 @@ class OrbExtractor : public PyramidExtractorBase {
 
   explicit OrbExtractor(const OrbParams& params = {});
 
+  // One row of the orientation circle as a byte mask over u = -16..15.
+  struct CircleRowMask {
+    alignas(16) std::uint8_t bytes[32];
+  };
+
   void extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                std::vector<OrbDescriptor>& descriptors);
 
@@ -58,10 +66,12 @@ class OrbExtractor : public PyramidExtractorBase {
 
   std::vector<int> featuresPerLevel_;
   std::vector<int> circleHalfWidth_;  // u_max of the orientation circle, per row offset
+  std::array<CircleRowMask, kHalfPatch + 1> circleRows_{};  // the same, as masks
   cv::Mat gray_;
   std::vector<cv::Mat> blurred_;  // per level: sizes differ, so one buffer would reallocate
   std::vector<cv::KeyPoint> fast_;
-  std::vector<Corner> corners_;
+  std::vector<Corner> corners_, scratch_;
+  std::vector<std::uint8_t> quadrant_;
   std::vector<Node> nodes_, nextNodes_;
   std::vector<int> cellCount_, selected_, splittable_;
   std::vector<Keypoint> levelKeypoints_;
