@@ -69,6 +69,8 @@ OrbParams readOrbParams(const YamlReader& yaml) {
   orb.minThFast = positiveInteger(yaml, "ORBextractor.minThFAST");
   if (orb.iniThFast > 255) throw yaml.error("ORBextractor.iniThFAST", "must be at most 255");
   if (orb.minThFast > orb.iniThFast) throw yaml.error("ORBextractor.minThFAST", "must not exceed iniThFAST");
+  if (yaml.has("ORBextractor.rightFeaturesFactor"))
+    orb.rightFeaturesFactor = positiveInteger(yaml, "ORBextractor.rightFeaturesFactor");
   return orb;
 }
 

@@ -166,12 +166,21 @@ TEST_F(MalformedSettings, WrongTypeOrValue) {
                  "ORBextractor.nLevels");
   expectKeyError("sequence_bf.yaml", replaced(tum1_, "Camera.bf: 40.0", "Camera.bf: [40.0, 1]"), "Camera.bf");
   expectKeyError("unknown_sensor.yaml", replaced(tum1_, "System.seed: 0", "Sensor: lidar"), "Sensor");
+  expectKeyError("zero_right_factor.yaml",
+                 replaced(tum1_, "DepthDisparitySigma: 0.125", "DepthDisparitySigma: 0.125\nORBextractor.rightFeaturesFactor: 0"),
+                 "ORBextractor.rightFeaturesFactor");
   expectKeyError("zero_disparity_sigma.yaml", replaced(tum1_, "DepthDisparitySigma: 0.125", "DepthDisparitySigma: 0"),
                  "DepthDisparitySigma");
   const std::string euroc = slurp(settingsDir() / "EuRoC.yaml");
   expectKeyError("short_P.yaml", replaced(euroc, "   rows: 3\n   cols: 4\n   dt: d\n   data: [435.2046959714599, 0, 367.4517211914062, -47",
                                           "   rows: 3\n   cols: 3\n   dt: d\n   data: [435.2046959714599, 0, 367.4517211914062, -47"),
                  "RIGHT.P.data");
+}
+
+TEST_F(MalformedSettings, RightFeaturesFactorIsOptional) {
+  EXPECT_EQ(Settings::load(dir_.write("plain.yaml", tum1_)).orb.rightFeaturesFactor, 1);
+  const std::string wider = replaced(tum1_, "DepthDisparitySigma: 0.125", "DepthDisparitySigma: 0.125\nORBextractor.rightFeaturesFactor: 3");
+  EXPECT_EQ(Settings::load(dir_.write("wider.yaml", wider)).orb.rightFeaturesFactor, 3);
 }
 
 TEST_F(MalformedSettings, TruncatedOrNotYaml) {

@@ -41,12 +41,17 @@ concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, cons
 } && CameraModel<typename S::Camera>;
 
 // A rectified stereo pair: ORB on both images, then stereo matching along rows (§III-A); the
-// two extractions run in parallel. rightBudgetFactor scales the right image's feature budget:
-// more right corners give more left keypoints a partner (55% -> 71% of left keypoints on the
-// synthetic room with 3x, tests/features/synthetic_stereo_test.cpp), but in the whole pipeline
-// 3x measured worse (benchmarks/eval_accuracy.sh: synthetic stereo loop 37.8 against 29.0 mm
-// closed, 105 against 67 mm open, KITTI 06 56.9 against 53.9 mm) and slower, so the default is
-// ORB-SLAM2's equal budgets.
+// two extractions run in parallel. OrbParams::rightFeaturesFactor (settings key
+// ORBextractor.rightFeaturesFactor) scales the right image's budget. With ORB-SLAM2's equal
+// budgets the two quadtrees keep different corners, and 55% of left keypoints find a partner
+// on the synthetic room; 3x gives 71% at the same disparity accuracy
+// (tests/features/synthetic_stereo_test.cpp). But more stereo points mean more tracked close
+// points, so the paper's keyframe rule (fewer than 100 tracked close points) fires less: on the
+// synthetic stereo loop 3x made 52/50/44 keyframes instead of 68/60/53 and measured worse
+// (benchmarks/eval_accuracy.sh: 39.9 against 28.1 mm closed, 92.1 against 69.1 mm open; KITTI
+// 06 52.7 against 53.5 mm). Raising that threshold to 140 restored the keyframes and most of
+// the accuracy (31.8 / 65.6 mm), which confirms the cause. The default keeps ORB-SLAM2's
+// equal budgets and the paper's rule.
 struct Stereo {
   using Camera = RectifiedStereoCamera<double>;
   using Input = StereoInput;
@@ -56,13 +61,13 @@ struct Stereo {
 
   class FeatureBuilder {
    public:
-    FeatureBuilder(const Camera& camera, const OrbParams& orb, int rightBudgetFactor = 1)
-        : camera_(camera), left_(orb), right_(rightParams(orb, rightBudgetFactor)) {}
+    FeatureBuilder(const Camera& camera, const OrbParams& orb)
+        : camera_(camera), left_(orb), right_(rightParams(orb)) {}
     FrameFeatures build(const Input& in) { return extractStereo(left_, right_, in.left, in.right, camera_, matcher_); }
 
    private:
-    static OrbParams rightParams(OrbParams orb, int factor) {
-      orb.features *= std::max(1, factor);
+    static OrbParams rightParams(OrbParams orb) {
+      orb.features *= std::max(1, orb.rightFeaturesFactor);
       return orb;
     }
     Camera camera_;
