@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -245,19 +244,15 @@ void printCoverage() {
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
-    // With --benchmark_repetitions the median of the repetitions; otherwise the single run.
-    for (const Run& r : runs) {
-      if (r.run_type == Run::RT_Iteration && r.iterations > 0 && !medians.contains(r.run_name.str()))
+    // With --benchmark_repetitions the median of the repetitions (aggregates are reported after
+    // the repetitions, so it overwrites them); otherwise the single run.
+    for (const Run& r : runs)
+      if ((r.run_type == Run::RT_Iteration && r.iterations > 0) ||
+          (r.run_type == Run::RT_Aggregate && r.aggregate_name == "median"))
         times[r.run_name.str()] = r.GetAdjustedCPUTime();
-      if (r.run_type == Run::RT_Aggregate && r.aggregate_name == "median") {
-        times[r.run_name.str()] = r.GetAdjustedCPUTime();
-        medians.insert(r.run_name.str());
-      }
-    }
     ConsoleReporter::ReportRuns(runs);
   }
   std::map<std::string, double> times;
-  std::set<std::string> medians;
 };
 
 }  // namespace

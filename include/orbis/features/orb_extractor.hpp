@@ -65,8 +65,7 @@ class OrbExtractor : public PyramidExtractorBase {
   void splitNode(const Node& n, Node children[4], int& count);
 
   std::vector<int> featuresPerLevel_;
-  std::vector<int> circleHalfWidth_;  // u_max of the orientation circle, per row offset
-  std::array<CircleRowMask, kHalfPatch + 1> circleRows_{};  // the same, as masks
+  std::array<CircleRowMask, kHalfPatch + 1> circleRows_{};  // orientation circle, per row offset
   cv::Mat gray_;
   std::vector<cv::Mat> blurred_;  // per level: sizes differ, so one buffer would reallocate
   std::vector<cv::KeyPoint> fast_;
