@@ -10,6 +10,10 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__SSE2__) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define ORBIS_AVX2_DISPATCH 1
+#endif
 
 #include "orb_pattern.hpp"
 
@@ -70,8 +74,8 @@ float centroidAngle(const std::uint8_t* center, int step, const OrbExtractor::Ci
 
 // The pattern as floats, one array per coordinate, points 2i and 2i+1 forming test i.
 struct PatternSoA {
-  alignas(16) float x[2 * OrbDescriptor::kBits];
-  alignas(16) float y[2 * OrbDescriptor::kBits];
+  alignas(32) float x[2 * OrbDescriptor::kBits];  // 32: the AVX2 path loads 8 at a time
+  alignas(32) float y[2 * OrbDescriptor::kBits];
   PatternSoA() {
     for (int k = 0; k < 2 * OrbDescriptor::kBits; ++k) {
       x[k] = static_cast<float>(detail::kOrbPattern[2 * k]);
@@ -84,14 +88,11 @@ const PatternSoA& pattern() {
   return p;
 }
 
-// Rotated BRIEF: each pattern point is rotated by the keypoint angle and rounded to the
-// nearest pixel (round-half-even, like cvRound), then 256 intensity comparisons.
-void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDescriptor& out) {
+// Each pattern point rotated by (cos, sin) = (a, b), rounded to the nearest pixel
+// (round-half-even, like cvRound), as an offset from the centre in a buffer of row `step`.
+void rotatedOffsets(float a, float b, int step, int* offset) {
   constexpr int kPoints = 2 * OrbDescriptor::kBits;
-  const float rad = angleDeg * static_cast<float>(CV_PI / 180.0);
-  const float a = std::cos(rad), b = std::sin(rad);
   const PatternSoA& p = pattern();
-  alignas(16) int offset[kPoints];
 #if defined(__SSE2__)
   const __m128 va = _mm_set1_ps(a), vb = _mm_set1_ps(b);
   const __m128 vstep = _mm_set1_ps(static_cast<float>(step));
@@ -107,6 +108,42 @@ void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDe
   for (int k = 0; k < kPoints; ++k)
     offset[k] = cvRound(p.x[k] * b + p.y[k] * a) * step + cvRound(p.x[k] * a - p.y[k] * b);
 #endif
+}
+
+#if defined(ORBIS_AVX2_DISPATCH)
+// The same with 8 lanes: the rotation was half of a descriptor's time with 4 (177 of ~360 ns;
+// 75 ns here). Chosen at run time, as default builds target baseline x86-64. The target is
+// "avx2" without "fma", so the products are not fused and round exactly as above.
+__attribute__((target("avx2"))) void rotatedOffsetsAvx2(float a, float b, int step, int* offset) {
+  constexpr int kPoints = 2 * OrbDescriptor::kBits;
+  const PatternSoA& p = pattern();
+  const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b);
+  const __m256i vstep = _mm256_set1_epi32(step);
+  for (int k = 0; k < kPoints; k += 8) {
+    const __m256 x = _mm256_load_ps(p.x + k), y = _mm256_load_ps(p.y + k);
+    const __m256i ix = _mm256_cvtps_epi32(_mm256_sub_ps(_mm256_mul_ps(x, va), _mm256_mul_ps(y, vb)));
+    const __m256i iy = _mm256_cvtps_epi32(_mm256_add_ps(_mm256_mul_ps(x, vb), _mm256_mul_ps(y, va)));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(offset + k), _mm256_add_epi32(_mm256_mullo_epi32(iy, vstep), ix));
+  }
+}
+
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+#endif
+
+// Rotated BRIEF: the pattern rotated by the keypoint angle, then 256 intensity comparisons.
+void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDescriptor& out) {
+  const float rad = angleDeg * static_cast<float>(CV_PI / 180.0);
+  const float a = std::cos(rad), b = std::sin(rad);
+  alignas(32) int offset[2 * OrbDescriptor::kBits];
+#if defined(ORBIS_AVX2_DISPATCH)
+  if (cpuHasAvx2())
+    rotatedOffsetsAvx2(a, b, step, offset);
+  else
+#endif
+    rotatedOffsets(a, b, step, offset);
   std::uint8_t* bytes = out.bytes();
   const int* o = offset;
   for (int i = 0; i < OrbDescriptor::kBytes; ++i) {
