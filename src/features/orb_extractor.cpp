@@ -372,6 +372,22 @@ void OrbExtractor::distribute(int wanted, float minX, float minY, float maxX, fl
   }
 }
 
+void orbBlur(const cv::Mat& src, cv::Mat& dst) {
+  // Why not cv::GaussianBlur: on a view into a larger image (our bordered levels) it takes its
+  // floating-point path, which rounds differently from ORB-SLAM2's blur of a cloned level (on
+  // 1.5% of pixels); on a whole image its bit-exact path costs twice this. sepFilter2D with taps
+  // that are exact multiples of 1/256 runs OpenCV's fixed-point separable filter: the same
+  // integer sums as the bit-exact path, ties rounded to even instead of up. EuRoC pyramid,
+  // one thread: 0.55 ms, against 0.64 (view) and 1.09 (whole levels).
+  static const cv::Mat taps = [] {
+    cv::Mat k(OrbExtractor::kBlurSize, 1, CV_32F);
+    for (int i = 0; i < OrbExtractor::kBlurSize; ++i)
+      k.at<float>(i) = static_cast<float>(OrbExtractor::kBlurTapsQ8[static_cast<std::size_t>(i)]) / 256.f;
+    return k;
+  }();
+  cv::sepFilter2D(src, dst, CV_8U, taps, taps, cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT_101);
+}
+
 void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                            std::vector<OrbDescriptor>& descriptors) {
   const cv::Mat& gray = detail::asGray8u(image, gray_, "OrbExtractor input");
@@ -396,8 +412,7 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
     cv::Mat& blurred = blurred_[static_cast<std::size_t>(l)];
     blurred.create(level.rows + 2 * b, level.cols + 2 * b, CV_8UC1);
     cv::Mat target = blurred(cv::Rect(b, b, level.cols, level.rows));
-    cv::GaussianBlur(level, target, cv::Size(kBlurSize, kBlurSize), kBlurSigma, kBlurSigma,
-                     cv::BORDER_REFLECT_101);
+    orbBlur(level, target);
 
     const int step = static_cast<int>(level.step);
     const int blurStep = static_cast<int>(blurred.step);

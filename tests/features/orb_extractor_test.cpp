@@ -118,6 +118,29 @@ TEST(OrbExtractor, OrientationAndDescriptorFollowExactRotation) {
   EXPECT_GT(far, static_cast<int>(d1.size()) * 8 / 10);
 }
 
+// The blur before the binary tests is ORB-SLAM2's GaussianBlur(7x7, sigma 2) of each level:
+// OpenCV's bit-exact result for a whole image, which only rounding ties may miss, by one. The
+// extractor blurs views into bordered levels, so the view must read its parent's pixels.
+TEST(OrbExtractor, BlurIsOpenCvsGaussian7x7Sigma2UpToTies) {
+  const cv::Mat image = test::texturedImage(640, 480, 11, 150);
+  cv::Mat reference;
+  cv::GaussianBlur(image, reference, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+  cv::Mat bordered;
+  cv::copyMakeBorder(image, bordered, 19, 19, 19, 19, cv::BORDER_REFLECT_101);
+  for (const cv::Mat& src : {image, bordered(cv::Rect(19, 19, 640, 480))}) {
+    cv::Mat ours;
+    orbBlur(src, ours);
+    ASSERT_EQ(ours.size(), reference.size());
+    cv::Mat diff;
+    cv::absdiff(ours, reference, diff);
+    double maxDiff = 0;
+    cv::minMaxLoc(diff, nullptr, &maxDiff);
+    EXPECT_LE(maxDiff, 1.0);
+    // Ties are ~1 pixel in 50,000; taps off by one (18 34 49 54) would miss ~2%.
+    EXPECT_LT(cv::countNonZero(diff), static_cast<int>(diff.total() / 5000)) << "more than ties differ";
+  }
+}
+
 TEST(OrbExtractor, PerLevelBudgetIsGeometric) {
   OrbParams p;
   p.features = 1000;

@@ -34,9 +34,11 @@ class OrbExtractor : public PyramidExtractorBase {
   static constexpr int kHalfPatch = 15;
   static constexpr int kEdge = 19;        // keypoints keep this far from each level's edge (ORB-SLAM)
   static constexpr int kCellSize = 30;    // FAST fallback cells, level pixels
-  // Gaussian applied before the binary tests (ORB-SLAM: 7x7, sigma 2).
+  // Gaussian applied before the binary tests (ORB-SLAM: 7x7, sigma 2), as the 8-bit fixed-point
+  // taps (sum 256) that cv::GaussianBlur quantises it to on a whole image, as in ORB-SLAM2.
   static constexpr int kBlurSize = 7;
   static constexpr double kBlurSigma = 2.0;
+  static constexpr std::array<int, kBlurSize> kBlurTapsQ8 = {18, 34, 48, 56, 48, 34, 18};
 
   explicit OrbExtractor(const OrbParams& params = {});
 
@@ -77,5 +79,10 @@ class OrbExtractor : public PyramidExtractorBase {
 };
 
 static_assert(FeatureExtractor<OrbExtractor>);
+
+// The extractor's pre-descriptor blur: `dst` = `src` filtered by OrbExtractor::kBlurTapsQ8 in
+// both directions, reflecting (101) at the borders of src's parent image. Equal to
+// cv::GaussianBlur(7x7, sigma 2) of a whole image up to rounding ties (off by one).
+void orbBlur(const cv::Mat& src, cv::Mat& dst);
 
 }  // namespace orbis
