@@ -135,7 +135,7 @@ TEST(SlamPipeline, TumTeddyRgbdDeterministic) {
   std::cout << "[slam] TUM teddy RGB-D: ATE " << *a.ateRmse * 1000 << " mm over " << a.ateMatched << " poses, "
             << a.stats.tracked << "/" << a.stats.frames << " tracked, " << a.stats.keyFrames << " keyframes\n";
   EXPECT_EQ(a.stats.lost, 0u);
-  // 4.3 mm measured (4.2-4.6 over feature budgets 900-1100); ORB-SLAM2's stereo residual for the
+  // 4.6 mm measured (4.3-4.7 over feature budgets 900-1100); ORB-SLAM2's stereo residual for the
   // depth readings gave 6.6 mm here, so 6 mm catches losing the disparity residual.
   EXPECT_LT(*a.ateRmse, 0.006);
   const fs::path out2 = fs::temp_directory_path() / "orbis_teddy_b";
