@@ -16,6 +16,20 @@ inline std::shared_ptr<const OrbVocabulary> sharedVocabulary() {
   return voc;
 }
 
+// One loop around the room at low resolution with image noise: enough drift for the loop to
+// matter, small enough to render and track in seconds.
+inline synth::SynthOptions loopSequence(std::uint64_t seed) {
+  synth::SynthOptions o;
+  o.frames = 300;  // frames per loop
+  o.width = 320;
+  o.height = 240;
+  o.fx = 250;
+  o.noiseSigma = 4.0;
+  o.seed = seed;
+  o.threads = 2;
+  return o;
+}
+
 // Synthetic depth maps are in metres (CV_32F), so the RGB-D camera's depth factor is 1.
 template <class Sensor>
 typename Sensor::Camera syntheticCamera(const synth::SyntheticSequence& seq, double baseline) {

@@ -47,7 +47,7 @@ void DenseCloudBuilder::addView(const SE3d& cameraToWorld, const cv::Mat& depth,
       const double z = rawToMetres * (depth.type() == CV_16U ? double(depth.at<std::uint16_t>(v, u))
                                                              : double(depth.at<float>(v, u)));
       if (!(z > 0) || !(z <= options_.maxDepth)) continue;  // also rejects NaN
-      const Eigen::Vector3d pc((u - camera_.cx) * z / camera_.fx, (v - camera_.cy) * z / camera_.fy, z);
+      const Eigen::Vector3d pc = camera_.unproject(Eigen::Vector2d(u, v), z);
       const Eigen::Vector3d pw = R * pc + t;
       std::int64_t key;
       if (!voxelKey(pw, options_.voxelSize, key)) continue;

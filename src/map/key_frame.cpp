@@ -17,15 +17,6 @@ KeyFrame::KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, co
       Tcw_(Tcw),
       points_(features_->size(), nullptr) {}
 
-bool KeyFrame::unprojectStereo(std::size_t i, Eigen::Vector3d& world) const {
-  const float z = features_->depth[i];
-  if (!(z > 0)) return false;
-  const Keypoint& k = features_->keypointsUn[i];
-  const Eigen::Vector3d pc((k.u - intrinsics.cx) * z / intrinsics.fx, (k.v - intrinsics.cy) * z / intrinsics.fy, z);
-  world = Tcw_.inverse() * pc;
-  return true;
-}
-
 void KeyFrame::erasePoint(const MapPoint* p) {
   for (auto& slot : points_)
     if (slot == p) slot = nullptr;

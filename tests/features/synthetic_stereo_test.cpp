@@ -8,7 +8,7 @@
 
 #include "orbis/features/frame_features.hpp"
 #include "orbis/features/orb_extractor.hpp"
-#include "orbis/system/sensor.hpp"
+#include "orbis/sensor/sensor.hpp"
 #include "orbis/synth/sequence.hpp"
 
 namespace orbis {
@@ -61,7 +61,7 @@ TEST(StereoMatcher, SyntheticSequenceDisparityAndShare) {
   // two views, and 924 of the 3012 left keypoints have no right keypoint within 1.5 px x scale
   // of their true partner (38 more fall outside the right view), so no matcher could pass ~69%.
   // Three times the budget on the right (ORBextractor.rightFeaturesFactor: 3) leaves 349
-  // without one and matches over 70%. Why the default stays at 1: Stereo in system/sensor.hpp.
+  // without one and matches over 70%. Why the default stays at 1: Stereo in sensor/sensor.hpp.
   EXPECT_GT(same.share, 0.5);
   EXPECT_GT(wider.share, 0.7);
   EXPECT_GT(wider.share, same.share);

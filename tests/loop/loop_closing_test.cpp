@@ -19,19 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace orbis;
 
-// One loop around the room at low resolution with image noise: enough drift for the loop to
-// matter, small enough to render and track in seconds.
-synth::SynthOptions loopSequence(std::uint64_t seed) {
-  synth::SynthOptions o;
-  o.frames = 300;  // frames per loop
-  o.width = 320;
-  o.height = 240;
-  o.fx = 250;
-  o.noiseSigma = 4.0;
-  o.seed = seed;
-  o.threads = 2;
-  return o;
-}
+using test::loopSequence;
 
 struct LoopRun {
   Trajectory estimate, keyFrames, groundTruth;
@@ -65,7 +53,7 @@ LoopRun runLoop(const synth::SynthOptions& options, bool loopClosing, bool deter
   run.estimate = slam.trajectory();
   run.keyFrames = slam.keyFrameTrajectory();
   run.stats = slam.stats();
-  if (const LoopCloser* closer = slam.core().loopCloser()) run.closures = closer->closures();
+  if (const auto* closer = slam.core().loopCloser()) run.closures = closer->closures();
   if (!run.closures.empty()) {
     std::lock_guard lock(slam.core().map().mutex());
     run.firstLoopKeyFrameFrame = slam.core().map().keyFrame(run.closures.front().loop)->frameIndex;

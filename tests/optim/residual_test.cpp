@@ -41,6 +41,21 @@ double worstOverTrials(std::uint32_t seed, const typename R::Observation& measur
   return worst;
 }
 
+// The pose is camera-1-from-camera-2 and the point lives in camera 1: it must be in front of camera 2.
+TEST(OptimResiduals, InversePoseReprojectionJacobians) {
+  const PinholeCamera<double> camera{320.0, 310.0, 160.0, 120.0, 320, 240};
+  std::mt19937 rng(7);
+  double worst = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const SE3d T12 = randomPose(rng, 0.8, 1.0);
+    const InversePoseReprojection<PinholeCamera<double>> residual{{150.0, 110.0}, &camera};
+    const auto d = test::checkJacobians(residual, T12, pointInFront(rng, T12.inverse()));
+    worst = std::max(worst, d.relative());
+  }
+  std::printf("InversePoseReprojection (2x6x3): max relative discrepancy %.3e\n", worst);
+  EXPECT_LT(worst, 1e-6);
+}
+
 TEST(OptimResiduals, MonoReprojectionJacobians) {
   const PinholeCamera<double> camera{458.0, 457.0, 367.0, 248.0, 752, 480};
   const double worst = worstOverTrials<MonoReprojection>(1, {300.0, 200.0}, camera);

@@ -3,6 +3,7 @@
 // full BA can be aborted, and the essential graph closes a loop.
 #include "../../benchmarks/ba_problem_generator.hpp"
 
+#include "orbis/io/bal.hpp"
 #include "orbis/optim/pose_graph.hpp"
 #include "orbis/optim/slam_ba.hpp"
 
@@ -119,10 +120,11 @@ TEST(OptimSlamBa, LocalBaDumpsItsProblemForReplay) {
   auto poses = scene.initialPoses;
   auto points = scene.initialPoints;
   BundleAdjustmentOptions options;
-  options.dumpBal = std::filesystem::temp_directory_path() / "orbis_local_ba_dump.txt";
+  const auto dump = std::filesystem::temp_directory_path() / "orbis_local_ba_dump.txt";
+  options.inspectBal = [&](const BalProblem& problem) { writeBal(dump, problem); };
   bundleAdjustment(scene.camera, poses, scene.poseFixed, points, scene.observations, options);
-  const BalProblem bal = readBal(options.dumpBal);
-  std::filesystem::remove(options.dumpBal);
+  const BalProblem bal = readBal(dump);
+  std::filesystem::remove(dump);
   EXPECT_EQ(bal.cameras.size(), scene.initialPoses.size());
   EXPECT_EQ(bal.points.size(), scene.initialPoints.size());
   EXPECT_EQ(bal.observations.size(), scene.observations.size());

@@ -10,16 +10,7 @@ namespace {
 
 using namespace orbis;
 
-MapIntrinsics testCamera() {
-  MapIntrinsics K;
-  K.fx = 520;
-  K.fy = 515;
-  K.cx = 318;
-  K.cy = 244;
-  K.maxX = 640;
-  K.maxY = 480;
-  return K;
-}
+PinholeCamera<double> testCamera() { return {520, 515, 318, 244, 640, 480}; }
 
 SE3d randomPose(std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
@@ -29,7 +20,7 @@ SE3d randomPose(std::mt19937_64& rng) {
 }
 
 // World points in front of the camera Tcw (depth 1-6 m, inside the image), and their pixels.
-void makeScene(const SE3d& Tcw, const MapIntrinsics& K, std::size_t n, std::mt19937_64& rng, Vector3dList& world,
+void makeScene(const SE3d& Tcw, const PinholeCamera<double>& K, std::size_t n, std::mt19937_64& rng, Vector3dList& world,
                Vector2dList& pixels) {
   std::uniform_real_distribution<double> u(0, 640), v(0, 480), z(1, 6);
   world.clear();
@@ -37,7 +28,7 @@ void makeScene(const SE3d& Tcw, const MapIntrinsics& K, std::size_t n, std::mt19
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d px(u(rng), v(rng));
     const double depth = z(rng);
-    const Eigen::Vector3d pc((px.x() - K.cx) * depth / K.fx, (px.y() - K.cy) * depth / K.fy, depth);
+    const Eigen::Vector3d pc = K.unproject(px, depth);
     world.push_back(Tcw.inverse() * pc);
     pixels.push_back(px);
   }
@@ -50,7 +41,7 @@ double rotationError(const SE3d& a, const SE3d& b) { return (a.so3().inverse() *
 // draws five).
 TEST(Epnp, RecoversExactPoseFromFiveAndMorePoints) {
   std::mt19937_64 rng(11);
-  const MapIntrinsics K = testCamera();
+  const PinholeCamera<double> K = testCamera();
   for (std::size_t n : {5u, 6u, 50u}) {
     for (int trial = 0; trial < 20; ++trial) {
       const SE3d truth = randomPose(rng);
@@ -67,7 +58,7 @@ TEST(Epnp, RecoversExactPoseFromFiveAndMorePoints) {
 
 TEST(Epnp, NoisyPixelsGiveAClosePose) {
   std::mt19937_64 rng(12);
-  const MapIntrinsics K = testCamera();
+  const PinholeCamera<double> K = testCamera();
   std::normal_distribution<double> noise(0, 1.0);
   const SE3d truth = randomPose(rng);
   Vector3dList world;
@@ -81,7 +72,7 @@ TEST(Epnp, NoisyPixelsGiveAClosePose) {
 }
 
 TEST(Epnp, RejectsTooFewOrDegeneratePoints) {
-  const MapIntrinsics K = testCamera();
+  const PinholeCamera<double> K = testCamera();
   SE3d T;
   Vector3dList world(3, Eigen::Vector3d(0, 0, 2));
   Vector2dList pixels(3, Eigen::Vector2d(320, 240));
@@ -93,7 +84,7 @@ TEST(Epnp, RejectsTooFewOrDegeneratePoints) {
 
 TEST(PnpRansac, FindsPoseAndInliersAmongOutliersDeterministically) {
   std::mt19937_64 sceneRng(13);
-  const MapIntrinsics K = testCamera();
+  const PinholeCamera<double> K = testCamera();
   const SE3d truth = randomPose(sceneRng);
   Vector3dList world;
   Vector2dList pixels;
@@ -132,7 +123,7 @@ TEST(PnpRansac, FindsPoseAndInliersAmongOutliersDeterministically) {
 
 TEST(PnpRansac, GivesUpOnPureNoise) {
   std::mt19937_64 sceneRng(14);
-  const MapIntrinsics K = testCamera();
+  const PinholeCamera<double> K = testCamera();
   Vector3dList world;
   Vector2dList pixels;
   makeScene(randomPose(sceneRng), K, 60, sceneRng, world, pixels);

@@ -165,3 +165,8 @@ class Vocabulary {
 using OrbVocabulary = Vocabulary<OrbDescriptor, HammingDistance>;
 
 }  // namespace orbis::bow
+
+namespace orbis {
+// The vocabulary of the SLAM pipeline, the map file and the keyframe database.
+using bow::OrbVocabulary;
+}  // namespace orbis

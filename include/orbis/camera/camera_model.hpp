@@ -36,6 +36,28 @@ concept CameraModel =
       { camera.closeDepthThreshold() } -> std::same_as<typename C::Scalar>;
     };
 
+// What only cameras that measure depth have (rectified stereo, RGB-D): an observation
+// (uL, v, uR) with uR = uL - bf/Z, the left image's pinhole, and the stereo baseline.
+template <class C>
+concept StereoCameraModel = CameraModel<C> && C::kObservationDim == 3 && C::kMetricDepth &&
+    requires(const C& camera, const Eigen::Matrix<typename C::Scalar, 3, 1>& obs) {
+      { camera.bf() } -> std::same_as<typename C::Scalar>;
+      { camera.baseline } -> std::convertible_to<typename C::Scalar>;
+      { camera.pinhole } -> std::convertible_to<PinholeCamera<typename C::Scalar>>;
+      { camera.unproject(obs) } -> std::same_as<Eigen::Matrix<typename C::Scalar, 3, 1>>;
+    };
+
+// The pinhole of the left (or only) image: where 2-D observations, normalised rays, epipolar
+// geometry and PnP live, whatever the camera adds on top of it.
+template <CameraModel C>
+const PinholeCamera<typename C::Scalar>& pinholeOf(const C& camera) {
+  if constexpr (requires { camera.pinhole; }) {
+    return camera.pinhole;
+  } else {
+    return camera;
+  }
+}
+
 template <CameraModel C>
 struct CameraTraits {
   using Scalar = typename C::Scalar;
@@ -48,5 +70,7 @@ struct CameraTraits {
 static_assert(CameraModel<PinholeCamera<double>> && CameraModel<PinholeCamera<float>>);
 static_assert(CameraModel<RectifiedStereoCamera<double>> && CameraModel<RectifiedStereoCamera<float>>);
 static_assert(CameraModel<RgbdCamera<double>> && CameraModel<RgbdCamera<float>>);
+static_assert(StereoCameraModel<RectifiedStereoCamera<double>> && StereoCameraModel<RgbdCamera<double>>);
+static_assert(!StereoCameraModel<PinholeCamera<double>>);
 
 }  // namespace orbis

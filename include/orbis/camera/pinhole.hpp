@@ -37,9 +37,10 @@ struct PinholeCamera {
     return {fx * pc.x() * invZ + cx, fy * pc.y() * invZ + cy};
   }
 
-  // The point at the given depth (z, not range) seen at pixel px.
+  // The point at the given depth (z, not range) seen at pixel px. Multiplying before dividing
+  // keeps normalizedRay (depth 1) exact and gives the map's depth points their historical bits.
   Vector3 unproject(const Vector2& px, S depth) const {
-    return {(px.x() - cx) / fx * depth, (px.y() - cy) / fy * depth, depth};
+    return {(px.x() - cx) * depth / fx, (px.y() - cy) * depth / fy, depth};
   }
 
   // Point on the normalised image plane (z = 1) seen at pixel px.

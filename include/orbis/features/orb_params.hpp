@@ -14,7 +14,7 @@ struct OrbParams {
   int iniThFast = 20;        // FAST threshold tried first in each grid cell
   int minThFast = 7;         // fallback FAST threshold for cells where nothing was found
   // Stereo only: the right image's budget is features x this. The right keypoints serve only as
-  // stereo partners; 1 is ORB-SLAM2 (see Stereo in system/sensor.hpp for what 3 changes).
+  // stereo partners; 1 is ORB-SLAM2 (see Stereo in sensor/sensor.hpp for what 3 changes).
   int rightFeaturesFactor = 1;
 };
 

@@ -23,7 +23,7 @@
 
 #include "orbis/camera/sensor_kind.hpp"
 #include "orbis/map/map.hpp"
-#include "orbis/tracking/tracker.hpp"
+#include "orbis/bow/vocabulary.hpp"
 
 namespace orbis {
 

@@ -19,12 +19,13 @@
 // Threaded: a worker consumes the queue. Deterministic: nothing runs until runUntilIdle(), which
 // does everything (full BA included) on the caller's thread, so results are bit-identical.
 // Each step holds Map::mutex(); the essential graph and full BA solve on copies outside it.
+// Templated on the sensor (its camera for every projection, its kernel for full BA); local
+// mapping is reached through LocalMappingControl. Bodies: loop_closer_impl.hpp (detection) and
+// loop_correction_impl.hpp (correction, full BA); built-in sensors compiled in src/loop/.
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -35,12 +36,13 @@
 #include <vector>
 
 #include "orbis/bow/keyframe_database.hpp"
+#include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
+#include "orbis/sensor/sensor.hpp"
+#include "orbis/util/queue_worker.hpp"
 #include "orbis/util/timing.hpp"
 
 namespace orbis {
-
-class LocalMapper;
 
 struct LoopCloserOptions {
   bool threaded = true;
@@ -63,10 +65,15 @@ struct LoopClosureEvent {
   int inliers = 0;               // matched points after the projection search
 };
 
+template <SensorConfiguration Sensor>
 class LoopCloser {
  public:
-  LoopCloser(Map& map, LocalMapper* mapper, bow::KeyframeDatabase& database, LoopCloserOptions options,
-             StageTimer* timer = nullptr);
+  using Camera = typename Sensor::Camera;
+  static_assert(Sensor::kMetricScale, "loop closing in SE(3) needs a metric sensor; Sim(3) loops are not available yet");
+
+  // `camera` must outlive the loop closer (the SLAM system owns it).
+  LoopCloser(const Camera& camera, Map& map, LocalMappingControl* mapper, bow::KeyframeDatabase& database,
+             LoopCloserOptions options, StageTimer* timer = nullptr);
   ~LoopCloser();
   LoopCloser(const LoopCloser&) = delete;
   LoopCloser& operator=(const LoopCloser&) = delete;
@@ -94,7 +101,6 @@ class LoopCloser {
     int matched = 0;
   };
 
-  void run();
   bool processOne();
   // Holding the map mutex:
   void dropBadKeyFrames();
@@ -114,18 +120,14 @@ class LoopCloser {
   void resumeMapping();
   void report(const std::string& line) const;
 
+  const Camera& camera_;
   Map& map_;
-  LocalMapper* mapper_;
+  LocalMappingControl* mapper_;
   bow::KeyframeDatabase& database_;
   LoopCloserOptions options_;
   StageTimer* timer_;
   std::mt19937 rng_;
 
-  mutable std::mutex queueMutex_;
-  std::condition_variable queueCv_;
-  std::deque<KeyFrame*> queue_;
-  std::atomic<bool> busy_{false};
-  std::atomic<bool> finish_{false};
 
   std::vector<KeyFrame*> indexed_;  // keyframes in the database (loop thread only)
   std::vector<ConsistentGroup> consistentGroups_;
@@ -139,7 +141,15 @@ class LoopCloser {
   std::atomic<bool> abortFullBa_{false};
   std::atomic<bool> fullBaRunning_{false};
 
-  std::thread worker_;
+  QueueWorker<KeyFrame*> worker_;  // last: its thread stops before the state it serves goes
 };
 
+}  // namespace orbis
+
+#include "orbis/loop/loop_closer_impl.hpp"
+#include "orbis/loop/loop_correction_impl.hpp"
+
+namespace orbis {
+extern template class LoopCloser<Stereo>;
+extern template class LoopCloser<Rgbd>;
 }  // namespace orbis

@@ -4,13 +4,16 @@
 // Contract: a PointPair holds one matched map point expressed in each camera (p1 in keyframe 1,
 // p2 in keyframe 2) and the keypoint it was observed at in each image, with the information
 // 1/σ² of the keypoint's pyramid level. T12 maps camera-2 coordinates into camera 1.
+// Both keyframes share the sensor's camera; projections go through its pinhole.
 //  - estimateRelativePoseRansac: minimal 3-point closed-form solutions (Horn/Umeyama) on random
 //    triples drawn from the caller's generator; a pair is an inlier when it reprojects within
 //    χ²(2 dof, 99%) = 9.21 σ² in both images. Returns the best hypothesis re-estimated from all
 //    its inliers, `found` only with at least minInliers inliers.
-//  - refineRelativePose: Gauss-Newton on the two-way reprojection error (TwoWayReprojection,
-//    Huber kernel), twice, dropping after the first round the pairs whose χ² in either image
-//    exceeds `outlierChi2`; returns the inliers left. Same inputs, same output, bit for bit.
+//  - refineRelativePose: the two-way reprojection error (optim::MonoReprojection into camera 1,
+//    optim::InversePoseReprojection into camera 2, Huber kernel at `outlierChi2`) minimised by
+//    the library's Levenberg–Marquardt (optim::Problem) over T12 with the points fixed, twice,
+//    dropping after the first round the pairs whose χ² in either image exceeds `outlierChi2`;
+//    returns the inliers left. Same inputs, same output, bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -19,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include "orbis/camera/pinhole.hpp"
 #include "orbis/geometry/se3.hpp"
 
 namespace orbis::loop {
@@ -29,14 +33,13 @@ struct PointPair {
   double information1 = 1, information2 = 1;
 };
 
-// Residual of one pair under T12: (obs1 − π(T12·p2), obs2 − π(T12⁻¹·p1)). Jacobian for the left
-// update T12 ← exp(δ)·T12, δ in Sophus order (υ, ω). Returns false when a point falls behind a
-// camera (residual and Jacobian not written).
-struct TwoWayReprojection {
-  double fx, fy, cx, cy;
-  bool evaluate(const SE3d& T12, const PointPair& pair, Eigen::Matrix<double, 4, 1>& r,
-                Eigen::Matrix<double, 4, 6>* J) const;
+// A pair's χ² (information·‖π(T12·p2) − obs1‖², and the same for π(T12⁻¹·p1) against obs2);
+// not valid when the point falls behind either camera.
+struct PairChi2 {
+  double chi2First = 0, chi2Second = 0;
+  bool valid = false;
 };
+PairChi2 pairChi2(const PinholeCamera<double>& camera, const SE3d& T12, const PointPair& pair);
 
 struct RelativePoseRansacOptions {
   int iterations = 300;
@@ -51,12 +54,11 @@ struct RelativePoseEstimate {
   int inlierCount = 0;
 };
 
-// `camera` gives the pinhole intrinsics both keyframes share.
-RelativePoseEstimate estimateRelativePoseRansac(const std::vector<PointPair>& pairs, const TwoWayReprojection& camera,
+RelativePoseEstimate estimateRelativePoseRansac(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera,
                                                 const RelativePoseRansacOptions& options, std::mt19937& rng);
 
 // Refines T12 over the pairs flagged in `inliers` and rewrites the flags.
-int refineRelativePose(const std::vector<PointPair>& pairs, const TwoWayReprojection& camera, SE3d& T12,
+int refineRelativePose(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera, SE3d& T12,
                        std::vector<char>& inliers, double outlierChi2 = 10.0);
 
 // Closed-form least-squares rigid transform with target ≈ T·source (Umeyama, scale 1).

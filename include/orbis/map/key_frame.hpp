@@ -14,15 +14,17 @@
 #include <vector>
 
 #include "orbis/bow/bow_vector.hpp"
+#include "orbis/camera/camera_model.hpp"
 #include "orbis/features/frame_features.hpp"
 #include "orbis/geometry/se3.hpp"
 #include "orbis/map/map_point.hpp"
 
 namespace orbis {
 
-// What the map needs to know of the camera, whatever the sensor: pinhole intrinsics of the
+// The camera a keyframe was taken with, as the map file records it: pinhole intrinsics of the
 // (undistorted, rectified) left image, the stereo/RGB-D baseline times fx (0 for monocular),
-// the close/far depth threshold and the image bounds keypoints may fall in.
+// the close/far depth threshold and the image bounds keypoints may fall in. The pipeline reads
+// only the bounds (inImage); it projects through the sensor's compile-time camera model.
 struct MapIntrinsics {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   double bf = 0;          // baseline × fx; 0 for a monocular camera
@@ -34,6 +36,18 @@ struct MapIntrinsics {
 
   bool inImage(double u, double v) const { return u >= minX && u < maxX && v >= minY && v < maxY; }
 };
+
+// World point of keypoint i of `features` from its depth (stereo or RGB-D), seen from the pose
+// Tcw; false for a keypoint without depth. Frames and keyframes both lift points through it.
+template <CameraModel Camera>
+bool pointFromDepth(const Camera& camera, const FrameFeatures& features, std::size_t i, const SE3d& Tcw,
+                    Eigen::Vector3d& world) {
+  const float z = features.depth[i];
+  if (!(z > 0)) return false;
+  const Keypoint& k = features.keypointsUn[i];
+  world = Tcw.inverse() * camera.unproject(Eigen::Vector2d(k.u, k.v), static_cast<double>(z));
+  return true;
+}
 
 class KeyFrame {
  public:
@@ -53,8 +67,6 @@ class KeyFrame {
   std::size_t size() const { return points_.size(); }
   const bow::BowVector& bowVector() const { return bow_; }
   const bow::FeatureVector& featureVector() const { return featureVector_; }
-  // Camera-frame 3-D point of keypoint i from its depth, or nothing for a monocular keypoint.
-  bool unprojectStereo(std::size_t i, Eigen::Vector3d& world) const;
 
   // ---- pose (camera-from-world) ------------------------------------------------------------
   const SE3d& Tcw() const { return Tcw_; }

@@ -7,18 +7,22 @@
 // Threaded: a worker thread consumes the queue (local BA can be interrupted by tracking).
 // Deterministic: nothing runs until the owner calls runUntilIdle(), which processes the whole
 // queue on the caller's thread. Each step holds Map::mutex(); local BA solves on a copy
-// outside it. Processed keyframes are passed to the keyframe sink (loop closing).
+// outside it. Processed keyframes are passed to the keyframe sink (loop closing). Templated on
+// the sensor (its camera for every projection, its kernel for local BA, its trait for the
+// stereo-only rules); tracking and loop closing reach it through LocalMappingControl. Bodies:
+// local_mapper_impl.hpp; the built-in sensors are compiled in src/mapping/local_mapper.cpp.
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
-#include <deque>
 #include <functional>
 #include <list>
 #include <mutex>
 #include <thread>
 
+#include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
+#include "orbis/sensor/sensor.hpp"
+#include "orbis/util/queue_worker.hpp"
 #include "orbis/util/timing.hpp"
 
 namespace orbis {
@@ -30,27 +34,31 @@ struct LocalMapperOptions {
   bool cullKeyFrames = true;
 };
 
-class LocalMapper {
+template <SensorConfiguration Sensor>
+class LocalMapper final : public LocalMappingControl {
  public:
-  LocalMapper(Map& map, LocalMapperOptions options, StageTimer* timer = nullptr);
-  ~LocalMapper();
+  using Camera = typename Sensor::Camera;
+
+  // `camera` must outlive the mapper (the SLAM system owns it).
+  LocalMapper(const Camera& camera, Map& map, LocalMapperOptions options, StageTimer* timer = nullptr);
+  ~LocalMapper() override;
   LocalMapper(const LocalMapper&) = delete;
   LocalMapper& operator=(const LocalMapper&) = delete;
 
   // Called by tracking (with the map mutex held): queue a new keyframe.
-  void insertKeyFrame(KeyFrame* kf);
-  std::size_t queuedKeyFrames() const;
-  bool acceptsKeyFrames() const { return acceptKeyFrames_.load(); }
-  void interruptBundleAdjustment() { abortBA_ = true; }
+  void insertKeyFrame(KeyFrame* kf) override;
+  std::size_t queuedKeyFrames() const override;
+  bool acceptsKeyFrames() const override { return acceptKeyFrames_.load(); }
+  void interruptBundleAdjustment() override { abortBA_ = true; }
 
   // Loop closing pauses local mapping while it corrects the map.
-  void requestStop();
-  bool isStopped() const;
-  bool isStoppedOrStopping() const;
+  void requestStop() override;
+  bool isStopped() const override;
+  bool isStoppedOrStopping() const override;
   // While set, a stop request is not honoured (tracking is creating a keyframe). Returns false
   // when the mapper is already stopped.
-  bool setNotStop(bool flag);
-  void release();
+  bool setNotStop(bool flag) override;
+  void release() override;
 
   // Deterministic mode: process every queued keyframe now, on this thread.
   void runUntilIdle();
@@ -63,7 +71,7 @@ class LocalMapper {
   void setCulledKeyFrameSink(std::function<void(KeyFrame*)> sink) { culledSink_ = std::move(sink); }
 
  private:
-  void run();
+  void serveQueue();  // the worker's turn (threaded mode)
   bool processOne();
   void processNewKeyFrame(KeyFrame* kf);
   void cullRecentPoints(KeyFrame* kf);
@@ -72,24 +80,27 @@ class LocalMapper {
   void cullKeyFrames(KeyFrame* kf);
   bool stopIfRequested();
 
+  const Camera& camera_;
   Map& map_;
   LocalMapperOptions options_;
   StageTimer* timer_;
   std::function<void(KeyFrame*)> sink_, culledSink_;
 
-  mutable std::mutex queueMutex_;
-  std::condition_variable queueCv_;
-  std::deque<KeyFrame*> queue_;
   std::list<MapPoint*> recentPoints_;
   std::atomic<bool> acceptKeyFrames_{true};
   std::atomic<bool> abortBA_{false};
-  std::atomic<bool> busy_{false};
-  std::atomic<bool> finish_{false};
 
   mutable std::mutex stopMutex_;
   bool stopRequested_ = false, stopped_ = false, notStop_ = false;
 
-  std::thread worker_;
+  QueueWorker<KeyFrame*> worker_;  // last: its thread stops before the state it serves goes
 };
 
+}  // namespace orbis
+
+#include "orbis/mapping/local_mapper_impl.hpp"
+
+namespace orbis {
+extern template class LocalMapper<Stereo>;
+extern template class LocalMapper<Rgbd>;
 }  // namespace orbis

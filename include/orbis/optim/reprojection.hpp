@@ -78,6 +78,36 @@ struct DisparityReprojection {
 
 using DepthReprojection = DisparityReprojection<RectifiedStereoCamera<double>>;
 
+// The same projection seen from the other end of a relative pose: the pose variable T is
+// camera-1-from-camera-2, the point lives in camera 1, and camera 2 observes it:
+// r = camera.project(T⁻¹·X) − measurement. With the left update T ← exp(δ)·T,
+// T⁻¹·X = T⁻¹·exp(−δ)·X, so ∂(T⁻¹X)/∂δ = −R⁻¹·[I, −[X]×]. Loop closing's two-way relative pose
+// pairs it with Reprojection (camera 1 observing camera 2's point through T).
+template <CameraModel Camera>
+struct InversePoseReprojection {
+  using PoseManifold = SE3Manifold;
+  static constexpr int kDim = Camera::kObservationDim;
+  static constexpr bool kHasPoint = true;
+  using Observation = Eigen::Matrix<double, kDim, 1>;
+
+  Observation measurement;
+  const Camera* camera = nullptr;
+
+  void evaluate(const SE3d& T, const Eigen::Vector3d& point, Observation& r, Eigen::Matrix<double, kDim, 6>* jPose,
+                Eigen::Matrix<double, kDim, 3>* jPoint) const {
+    const SE3d inverse = T.inverse();
+    const Eigen::Vector3d pc = inverse * point;
+    r = camera->project(pc) - measurement;
+    if (!jPose && !jPoint) return;
+    const Eigen::Matrix<double, kDim, 3> dProjectR = camera->projectJacobian(pc) * inverse.rotationMatrix();
+    if (jPose) {
+      jPose->template leftCols<3>() = -dProjectR;
+      jPose->template rightCols<3>().noalias() = dProjectR * SO3d::hat(point);
+    }
+    if (jPoint) *jPoint = dProjectR;
+  }
+};
+
 // ORB-SLAM's per-observation information: σ² = scaleFactor^(2·octave), information = 1/σ².
 inline double levelInformation(double scaleFactor, int octave) {
   double sigma2 = 1.0;

@@ -8,13 +8,17 @@
 // (uL, v, uR) residual) or RgbdCamera (the depth reading as a whitened disparity,
 // DisparityReprojection, weighted by 1 / camera.disparitySigma, which must be positive);
 // monocular observations of a 3-D model use its pinhole.
-// Huber thresholds are the χ² 95% quantiles (5.991 mono, 7.815 stereo). Observations whose χ²
-// exceeds them after the robust pass, or whose point is behind the camera, are reported as
-// outliers, as ORB-SLAM classifies them. Nothing here throws (except writing the optional BAL
-// dump, which throws orbis::Error); a solve stops early when abortFlag is raised.
+// The robust kernel is a compile-time policy (any RobustKernel: Huber, ORB-SLAM's, by default;
+// Cauchy, Tukey or a user's), its thresholds the χ² 95% quantiles (5.991 mono, 7.815 stereo).
+// Passes "without kernel" solve the same residuals as terms of TrivialKernel (withoutKernel()),
+// so no kernel is ever asked to evaluate an infinite threshold. Observations whose χ² exceeds
+// the quantile after the robust pass, or whose point is behind the camera, are reported as
+// outliers, as ORB-SLAM classifies them. Nothing here throws; a solve stops early when
+// abortFlag is raised.
 #pragma once
 
-#include "orbis/io/bal.hpp"
+#include <functional>
+
 #include "orbis/optim/bal.hpp"
 #include "orbis/optim/problem.hpp"
 #include "orbis/optim/reprojection.hpp"
@@ -58,8 +62,9 @@ struct BundleAdjustmentOptions {
   double chi2Stereo = kChi2Stereo;
   const std::atomic<bool>* abortFlag = nullptr;
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
-  // When set, the problem is written there in BAL form before solving (for replay with `orbis ba`).
-  std::filesystem::path dumpBal;
+  // When set, receives the problem in BAL form before solving (write it with io/bal.hpp's
+  // writeBal for replay with `orbis ba`).
+  std::function<void(const BalProblem&)> inspectBal;
 };
 
 struct BundleAdjustmentResult {
@@ -81,32 +86,53 @@ struct MetricResidualFor<RgbdCamera<double>> {
 template <CameraModel Camera>
 using MetricResidual = typename MetricResidualFor<Camera>::type;
 
-// The problem type a camera model needs: a monocular term, plus a 3-D term for metric cameras.
-template <CameraModel Camera>
+// The problem type a camera model needs: a monocular term, plus a 3-D term for metric cameras,
+// each under the robust kernel Kernel.
+template <CameraModel Camera, RobustKernel Kernel>
 struct SlamProblemFor {
-  using type = Problem<SE3Manifold, Term<MonoReprojection, HuberKernel>, Term<MetricResidual<Camera>, HuberKernel>>;
+  using type = Problem<SE3Manifold, Term<MonoReprojection, Kernel>, Term<MetricResidual<Camera>, Kernel>>;
 };
-template <>
-struct SlamProblemFor<PinholeCamera<double>> {
-  using type = Problem<SE3Manifold, Term<MonoReprojection, HuberKernel>>;
+template <CameraModel Camera, RobustKernel Kernel>
+  requires(Camera::kObservationDim == 2)
+struct SlamProblemFor<Camera, Kernel> {
+  using type = Problem<SE3Manifold, Term<MonoReprojection, Kernel>>;
 };
-template <CameraModel Camera>
-using SlamProblem = typename SlamProblemFor<Camera>::type;
+template <CameraModel Camera, RobustKernel Kernel = HuberKernel>
+using SlamProblem = typename SlamProblemFor<Camera, Kernel>::type;
+
+// The same problem type with every term's kernel replaced by TrivialKernel.
+template <class P>
+struct WithoutKernelFor;
+template <Manifold M, class... Residuals, class... Kernels>
+struct WithoutKernelFor<Problem<M, Term<Residuals, Kernels>...>> {
+  using type = Problem<M, Term<Residuals, TrivialKernel>...>;
+};
+
+// A copy of `problem` — values, fixed flags, residuals, informations, active flags — whose terms
+// carry no kernel: how a pass "without kernel" is run. Residual ids stay valid in the copy.
+template <class P>
+typename WithoutKernelFor<P>::type withoutKernel(const P& problem) {
+  typename WithoutKernelFor<P>::type plain;
+  for (int i = 0; i < problem.numPoses(); ++i) plain.addPose(problem.pose(i), problem.poseFixed(i));
+  for (int l = 0; l < problem.numPoints(); ++l) plain.addPoint(problem.point(l), problem.pointFixed(l));
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    ((
+         [&] {
+           for (const auto& rec : problem.template records<I>()) {
+             const ResidualId id = plain.add(rec.residual, rec.pose, rec.other, rec.information);
+             if (!rec.active) plain.setActive(id, false);
+           }
+         }()),
+     ...);
+  }(std::make_index_sequence<P::kNumTerms>{});
+  return plain;
+}
 
 namespace slam_detail {
 
-template <CameraModel Camera>
-const PinholeCamera<double>& pinholeOf(const Camera& camera) {
-  if constexpr (requires { camera.pinhole; }) {
-    return camera.pinhole;
-  } else {
-    return camera;
-  }
-}
-
-// Adds one observation as a mono or stereo residual with its Huber threshold.
-template <CameraModel Camera>
-ResidualId addObservation(SlamProblem<Camera>& problem, const Camera& camera,
+// Adds one observation as a mono or stereo residual with its kernel threshold.
+template <CameraModel Camera, class P>
+ResidualId addObservation(P& problem, const Camera& camera,
                           const SlamObservation& o, double chi2Mono, double chi2Stereo) {
   if constexpr (Camera::kObservationDim == 3) {
     if (o.isStereo()) {
@@ -123,20 +149,6 @@ ResidualId addObservation(SlamProblem<Camera>& problem, const Camera& camera,
                      o.information, chi2Mono);
 }
 
-// Huber with an infinite threshold is the plain quadratic: how the kernel is removed.
-template <class P>
-void removeKernels(P& problem) {
-  [&]<std::size_t... I>(std::index_sequence<I...>) {
-    ((
-         [&] {
-           for (auto& rec : problem.template records<I>()) {
-             rec.delta2 = std::numeric_limits<double>::infinity();
-           }
-         }()),
-     ...);
-  }(std::make_index_sequence<P::kNumTerms>{});
-}
-
 // ORB-SLAM's classification: χ² above the quantile of the observation's dimension, or behind.
 template <class P>
 bool isOutlier(const P& problem, ResidualId id, const SlamObservation& o, double chi2Mono,
@@ -151,21 +163,21 @@ bool isOutlier(const P& problem, ResidualId id, const SlamObservation& o, double
 // Motion-only BA (tracking): the pose moves, the points stay. Four rounds of ten iterations;
 // after each round every observation is re-classified (outliers can come back), and only the
 // inliers take part in the next round, which starts again from the prior pose (or continues,
-// without restartEachRound).
-template <CameraModel Camera>
+// without restartEachRound). Rounds from options.robustRounds on run without kernel.
+template <RobustKernel Kernel = HuberKernel, CameraModel Camera>
 MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFromWorld,
                                             std::span<const Eigen::Vector3d> pointsWorld,
                                             std::span<const SlamObservation> observations,
                                             const MotionOnlyOptions& options = {}) {
-  SlamProblem<Camera> problem;
-  problem.addPose(cameraFromWorld);
-  for (const auto& p : pointsWorld) problem.addPoint(p, /*fixed=*/true);
+  SlamProblem<Camera, Kernel> robust;
+  robust.addPose(cameraFromWorld);
+  for (const auto& p : pointsWorld) robust.addPoint(p, /*fixed=*/true);
   std::vector<ResidualId> ids;
   ids.reserve(observations.size());
   for (const auto& o : observations) {
     SlamObservation single = o;
     single.pose = 0;
-    ids.push_back(slam_detail::addObservation(problem, camera, single, options.chi2Mono, options.chi2Stereo));
+    ids.push_back(slam_detail::addObservation(robust, camera, single, options.chi2Mono, options.chi2Stereo));
   }
   MotionOnlyResult result;
   result.outlier.assign(observations.size(), 0);
@@ -173,24 +185,29 @@ MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFr
   solver.maxIterations = options.iterationsPerRound;
   solver.linearSolver = LinearSolverKind::DenseCholesky;
   const SE3d prior = cameraFromWorld;
-  for (int round = 0; round < options.rounds; ++round) {
-    if (round == options.robustRounds) slam_detail::removeKernels(problem);
+  // One round on either problem; false when too few inliers are left to trust another.
+  auto round = [&](auto& problem) {
     if (options.restartEachRound) problem.setPose(0, prior);
     result.lastRound = problem.solve(solver);
     result.inliers = 0;
     for (std::size_t k = 0; k < observations.size(); ++k) {
-      SlamObservation single = observations[k];
-      single.pose = 0;
       // χ² only: a fixed point cannot be "behind" in a way the pose would not already show.
-      const double threshold = single.isStereo() && ids[k].term == 1 ? options.chi2Stereo : options.chi2Mono;
+      const double threshold = observations[k].isStereo() && ids[k].term == 1 ? options.chi2Stereo : options.chi2Mono;
       const bool out = problem.chi2(ids[k]) > threshold;
       result.outlier[k] = out;
       problem.setActive(ids[k], !out);
       result.inliers += !out;
     }
-    if (result.inliers < 10) break;  // too few to trust another round (ORB-SLAM's guard)
+    cameraFromWorld = problem.pose(0);
+    return result.inliers >= 10;  // ORB-SLAM's guard
+  };
+  int r = 0;
+  bool goOn = true;
+  for (; r < std::min(options.rounds, options.robustRounds) && goOn; ++r) goOn = round(robust);
+  if (goOn && r < options.rounds) {
+    auto plain = withoutKernel(robust);
+    for (; r < options.rounds && goOn; ++r) goOn = round(plain);
   }
-  cameraFromWorld = problem.pose(0);
   return result;
 }
 
@@ -198,13 +215,13 @@ MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFr
 // but are not covisible with the current one; full BA: the first keyframe). Runs a robust pass,
 // then — unless refineIterations is 0 or the solve was aborted — drops the outliers and refines
 // without kernel. Poses and points are updated in place.
-template <CameraModel Camera>
+template <RobustKernel Kernel = HuberKernel, CameraModel Camera>
 BundleAdjustmentResult bundleAdjustment(const Camera& camera, std::vector<SE3d>& cameraFromWorld,
                                         const std::vector<char>& poseFixed,
                                         std::vector<Eigen::Vector3d>& pointsWorld,
                                         std::span<const SlamObservation> observations,
                                         const BundleAdjustmentOptions& options = {}) {
-  SlamProblem<Camera> problem;
+  SlamProblem<Camera, Kernel> problem;
   for (std::size_t i = 0; i < cameraFromWorld.size(); ++i) {
     problem.addPose(cameraFromWorld[i], i < poseFixed.size() && poseFixed[i]);
   }
@@ -214,7 +231,7 @@ BundleAdjustmentResult bundleAdjustment(const Camera& camera, std::vector<SE3d>&
   for (const auto& o : observations) {
     ids.push_back(slam_detail::addObservation(problem, camera, o, options.chi2Mono, options.chi2Stereo));
   }
-  if (!options.dumpBal.empty()) writeBal(options.dumpBal, exportBal(problem));
+  if (options.inspectBal) options.inspectBal(exportBal(problem));
   SolverOptions solver;
   solver.maxIterations = options.iterations;
   solver.abortFlag = options.abortFlag;
@@ -222,28 +239,33 @@ BundleAdjustmentResult bundleAdjustment(const Camera& camera, std::vector<SE3d>&
   BundleAdjustmentResult result;
   result.robustPass = problem.solve(solver);
   result.outlier.assign(observations.size(), 0);
-  auto classify = [&] {
+  auto classify = [&](const auto& solved) {
     for (std::size_t k = 0; k < observations.size(); ++k) {
-      result.outlier[k] = slam_detail::isOutlier(problem, ids[k], observations[k], options.chi2Mono,
+      result.outlier[k] = slam_detail::isOutlier(solved, ids[k], observations[k], options.chi2Mono,
                                                  options.chi2Stereo);
     }
   };
-  classify();
+  auto writeBack = [&](const auto& solved) {
+    for (std::size_t i = 0; i < cameraFromWorld.size(); ++i) cameraFromWorld[i] = solved.pose(static_cast<int>(i));
+    for (std::size_t l = 0; l < pointsWorld.size(); ++l) pointsWorld[l] = solved.point(static_cast<int>(l));
+  };
+  classify(problem);
   if (options.refineIterations > 0 && result.robustPass.termination != Termination::Aborted) {
     for (std::size_t k = 0; k < observations.size(); ++k) problem.setActive(ids[k], !result.outlier[k]);
-    slam_detail::removeKernels(problem);
+    auto plain = withoutKernel(problem);
     solver.maxIterations = options.refineIterations;
-    result.refinePass = problem.solve(solver);
-    classify();
+    result.refinePass = plain.solve(solver);
+    classify(plain);
+    writeBack(plain);
+  } else {
+    writeBack(problem);
   }
-  for (std::size_t i = 0; i < cameraFromWorld.size(); ++i) cameraFromWorld[i] = problem.pose(static_cast<int>(i));
-  for (std::size_t l = 0; l < pointsWorld.size(); ++l) pointsWorld[l] = problem.point(static_cast<int>(l));
   return result;
 }
 
 // Full BA after a loop closure (paper §III-D): every keyframe and point, the first keyframe
-// fixed, Huber throughout, abortable. ORB-SLAM runs 20 iterations here.
-template <CameraModel Camera>
+// fixed, the kernel throughout, abortable. ORB-SLAM runs 20 iterations here.
+template <RobustKernel Kernel = HuberKernel, CameraModel Camera>
 BundleAdjustmentResult fullBundleAdjustment(const Camera& camera, std::vector<SE3d>& cameraFromWorld,
                                             std::vector<Eigen::Vector3d>& pointsWorld,
                                             std::span<const SlamObservation> observations,
@@ -255,7 +277,7 @@ BundleAdjustmentResult fullBundleAdjustment(const Camera& camera, std::vector<SE
   options.iterations = iterations;
   options.refineIterations = 0;
   options.abortFlag = abortFlag;
-  return bundleAdjustment(camera, cameraFromWorld, fixed, pointsWorld, observations, options);
+  return bundleAdjustment<Kernel>(camera, cameraFromWorld, fixed, pointsWorld, observations, options);
 }
 
 }  // namespace orbis::optim

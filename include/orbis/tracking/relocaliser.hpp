@@ -16,7 +16,9 @@
 //    accepted at 50 inliers. On success the frame holds the pose and its inlier matches
 //    (outliers cleared) and true is returned; on failure the frame's matches are cleared.
 //    Candidates are tried in the database's deterministic order; the RANSAC generator is seeded
-//    from (seed, frame index), so a run is reproducible whatever happened before.
+//    from (seed, frame index), so a run is reproducible whatever happened before. Templated on
+//    the sensor (its camera projects, its kernel weighs motion-only BA); bodies in
+//    relocaliser_impl.hpp, the built-in sensors compiled in src/tracking/relocaliser.cpp.
 #pragma once
 
 #include <cstdint>
@@ -28,14 +30,16 @@
 
 #include "orbis/bow/keyframe_database.hpp"
 #include "orbis/map/map.hpp"
-#include "orbis/tracking/frame.hpp"
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/map/frame.hpp"
+#include "orbis/sensor/sensor.hpp"
 
 namespace orbis {
 
 using Vector3dList = std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>>;
 using Vector2dList = std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>>;
 
-bool solveEpnp(const Vector3dList& world, const Vector2dList& pixels, const MapIntrinsics& K, SE3d& Tcw);
+bool solveEpnp(const Vector3dList& world, const Vector2dList& pixels, const PinholeCamera<double>& K, SE3d& Tcw);
 
 struct PnpRansacParams {
   double probability = 0.99;
@@ -53,7 +57,7 @@ struct PnpRansacResult {
 
 // sigma2[i]: variance of pixel i's measurement (its pyramid level's σ²).
 PnpRansacResult solvePnpRansac(const Vector3dList& world, const Vector2dList& pixels,
-                               const std::vector<float>& sigma2, const MapIntrinsics& K,
+                               const std::vector<float>& sigma2, const PinholeCamera<double>& K,
                                const PnpRansacParams& params, std::mt19937_64& rng);
 
 struct RelocaliserOptions {
@@ -70,17 +74,20 @@ struct RelocalisationStats {
   KeyFrameId lastKeyFrame = 0;  // the keyframe the last success matched
 };
 
+template <SensorConfiguration Sensor>
 class Relocaliser {
  public:
+  using FrameT = Frame<typename Sensor::Camera>;
+
   Relocaliser(const Map& map, const bow::KeyframeDatabase& database, RelocaliserOptions options = {})
       : map_(map), database_(database), options_(options) {}
 
-  bool relocalise(Frame& frame);
+  bool relocalise(FrameT& frame);
   const RelocalisationStats& stats() const { return stats_; }
 
  private:
   // Pose and matches of `frame` from one candidate's BoW matches; false when rejected.
-  bool tryCandidate(Frame& frame, const KeyFrame& kf, const std::vector<MapPoint*>& bowMatches,
+  bool tryCandidate(FrameT& frame, const KeyFrame& kf, const std::vector<MapPoint*>& bowMatches,
                     std::mt19937_64& rng) const;
 
   const Map& map_;
@@ -89,4 +96,11 @@ class Relocaliser {
   RelocalisationStats stats_;
 };
 
+}  // namespace orbis
+
+#include "orbis/tracking/relocaliser_impl.hpp"
+
+namespace orbis {
+extern template class Relocaliser<Stereo>;
+extern template class Relocaliser<Rgbd>;
 }  // namespace orbis

@@ -1,4 +1,5 @@
-// orbis/tracking/tracker.hpp — the tracking thread of the paper (§III, Fig. 2a), sensor-agnostic.
+// orbis/tracking/tracker.hpp — the tracking thread of the paper (§III, Fig. 2a), templated on the
+// sensor configuration.
 //
 // Contract: track(frame) estimates the frame's camera pose against the map and decides whether
 // it becomes a keyframe. On the first frame with enough depth it bootstraps the map (§III-B).
@@ -7,6 +8,9 @@
 // rejection; the ORB-SLAM2 keyframe rule including the close-point rule (τt, τc). It holds
 // Map::mutex() while it reads or changes the map. Every tracked frame's pose is kept relative
 // to its reference keyframe, so trajectory() reflects later map corrections (loops, BA).
+// What differs by sensor is asked of the trait at compile time: the search windows (RGB-D's
+// depth from a sensor), the stereo checks, and which keypoints may be lifted from depth.
+// Bodies: tracker_impl.hpp; Tracker<Stereo> and Tracker<Rgbd> are compiled in src/tracking/.
 #pragma once
 
 #include <functional>
@@ -14,14 +18,14 @@
 #include <vector>
 
 #include "orbis/bow/vocabulary.hpp"
+#include "orbis/map/frame.hpp"
+#include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
-#include "orbis/tracking/frame.hpp"
+#include "orbis/sensor/sensor.hpp"
 #include "orbis/util/timing.hpp"
 
 namespace orbis {
 
-using OrbVocabulary = bow::Vocabulary<OrbDescriptor, HammingDistance>;
-class LocalMapper;
 
 enum class TrackingState { NotInitialised, Ok, Lost };
 const char* toString(TrackingState s);
@@ -51,29 +55,38 @@ struct TrackedFrame {
   SE3d Tcr;  // camera-from-reference-keyframe
 };
 
+// Camera-from-world of a tracked frame through its (possibly since culled) reference keyframe.
+SE3d worldPoseOf(const TrackedFrame& f);
+
+template <SensorConfiguration Sensor>
 class Tracker {
  public:
-  Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMapper* mapper, TrackerOptions options,
+  using Camera = typename Sensor::Camera;
+  using FrameT = Frame<Camera>;
+  static_assert(Sensor::kMetricScale,
+                "the tracker bootstraps the map from one frame's depth; two-view (monocular) "
+                "initialisation is not available yet");
+
+  Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMappingControl* mapper, TrackerOptions options,
           StageTimer* timer = nullptr);
 
-  TrackResult track(Frame frame);
+  TrackResult track(FrameT frame);
 
   TrackingState state() const { return state_; }
   void setLocalisationOnly(bool on) { options_.localisationOnly = on; }
   bool localisationOnly() const { return options_.localisationOnly; }
   // Every tracked frame, by index. Read with the map mutex held (poses move with the map).
   const std::vector<TrackedFrame>& trackedFrames() const { return tracked_; }
-  // Camera-from-world of a tracked frame through its (possibly since culled) reference keyframe.
-  static SE3d worldPose(const TrackedFrame& f);
+  static SE3d worldPose(const TrackedFrame& f) { return worldPoseOf(f); }
   // Relocalisation hook (loop module): given the frame, returns true and sets its pose/matches
   // when it found itself in the map again.
-  void setRelocaliser(std::function<bool(Frame&)> relocalise) { relocalise_ = std::move(relocalise); }
+  void setRelocaliser(std::function<bool(FrameT&)> relocalise) { relocalise_ = std::move(relocalise); }
   // A map was loaded: the first frames must relocalise in it rather than start a new map.
   void startLost() { state_ = TrackingState::Lost; }
 
  private:
-  void computeBow(Frame& f) const;
-  bool bootstrap(Frame& f);
+  void computeBow(FrameT& f) const;
+  bool bootstrap(FrameT& f);
   bool trackReferenceKeyFrame();
   // Projects the last frame's matches through `motion` (current from last) and optimises.
   bool trackWithMotionModel(const SE3d& motion);
@@ -83,7 +96,7 @@ class Tracker {
   }
   bool trackLocalMap();
   void updateLastFrame();
-  void replaceRetiredPoints(Frame& f);
+  void replaceRetiredPoints(FrameT& f);
   void updateLocalMap();
   int searchLocalPoints();
   bool needNewKeyFrame() const;
@@ -93,13 +106,13 @@ class Tracker {
 
   Map& map_;
   const OrbVocabulary& vocabulary_;
-  LocalMapper* mapper_;
+  LocalMappingControl* mapper_;
   TrackerOptions options_;
   StageTimer* timer_;
-  std::function<bool(Frame&)> relocalise_;
+  std::function<bool(FrameT&)> relocalise_;
 
   TrackingState state_ = TrackingState::NotInitialised;
-  Frame current_, last_;
+  FrameT current_, last_;
   std::optional<SE3d> velocity_;  // Tcw(current) * Twc(last) of the last tracked pair
   KeyFrame* reference_ = nullptr;
   std::uint64_t lastKeyFrameFrame_ = 0;
@@ -111,4 +124,11 @@ class Tracker {
   std::vector<TrackedFrame> tracked_;
 };
 
+}  // namespace orbis
+
+#include "orbis/tracking/tracker_impl.hpp"
+
+namespace orbis {
+extern template class Tracker<Stereo>;
+extern template class Tracker<Rgbd>;
 }  // namespace orbis

@@ -1,26 +1,29 @@
-#include "orbis/loop/loop_matching.hpp"
+// orbis/map/keyframe_matching_impl.hpp — bodies of the searches declared in
+// keyframe_matching.hpp.
+//
+// Contract: included by keyframe_matching.hpp only; see there.
+#pragma once
 
 #include <cmath>
 #include <set>
 
-#include "orbis/tracking/map_matching.hpp"
+#include "orbis/map/keyframe_matching.hpp"
+#include "orbis/map/map_matching.hpp"
 
-namespace orbis::loop {
+namespace orbis::matching {
 
-namespace {
-
-using matching::kThHigh;
-using matching::kThLow;
+namespace keyframe_detail {
 
 // Where a point seen from pose Tcw should appear in `kf`, and the pyramid level it predicts;
 // false when it is behind the camera, off the image or outside its scale-invariance range.
-bool predict(const KeyFrame& kf, const SE3d& Tcw, const Eigen::Vector3d& world, const MapPoint& point, float& u,
-             float& v, int& level, bool checkViewAngle) {
+template <CameraModel Camera>
+bool predict(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw, const Eigen::Vector3d& world,
+             const MapPoint& point, float& u, float& v, int& level, bool checkViewAngle) {
   const Eigen::Vector3d pc = Tcw * world;
   if (pc.z() <= 0) return false;
-  const MapIntrinsics& K = kf.intrinsics;
-  const double x = K.fx * pc.x() / pc.z() + K.cx, y = K.fy * pc.y() / pc.z() + K.cy;
-  if (!K.inImage(x, y)) return false;
+  const Eigen::Vector2d xy = pinholeOf(camera).project(pc);
+  const double x = xy.x(), y = xy.y();
+  if (!kf.intrinsics.inImage(x, y)) return false;
   const Eigen::Vector3d po = world - Tcw.inverse().translation();
   const auto dist = static_cast<float>(po.norm());
   if (dist < point.minDistanceInvariance() || dist > point.maxDistanceInvariance()) return false;
@@ -35,7 +38,7 @@ bool predict(const KeyFrame& kf, const SE3d& Tcw, const Eigen::Vector3d& world, 
 
 // Best keypoint of `kf` near (u, v) for `descriptor`, at most `maxDistance` away in Hamming
 // distance; -1 when none.
-long bestInArea(const KeyFrame& kf, float u, float v, int level, float radius, const OrbDescriptor& descriptor,
+inline long bestInArea(const KeyFrame& kf, float u, float v, int level, float radius, const OrbDescriptor& descriptor,
                 int maxDistance, const std::vector<MapPoint*>* taken) {
   const FrameFeatures& f = kf.features();
   const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
@@ -53,9 +56,9 @@ long bestInArea(const KeyFrame& kf, float u, float v, int level, float radius, c
   return bestDist <= maxDistance ? best : -1;
 }
 
-}  // namespace
+}  // namespace keyframe_detail
 
-int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<MapPoint*>& matches12, float ratio) {
+inline int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<MapPoint*>& matches12, float ratio) {
   const FrameFeatures& f1 = kf1.features();
   const FrameFeatures& f2 = kf2.features();
   matches12.assign(kf1.size(), nullptr);
@@ -95,7 +98,8 @@ int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<Ma
   return matches;
 }
 
-int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
+template <CameraModel Camera>
+int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
                         float radius) {
   const SE3d T21 = T12.inverse();
   const SE3d T1w = kf1.Tcw(), T2w = kf2.Tcw();
@@ -113,8 +117,8 @@ int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T1
     if (!p || p->isBad() || alreadyMatched.count(p)) continue;
     float u, v;
     int level;
-    if (!predict(kf1, T1w_via2, p->position(), *p, u, v, level, false)) continue;
-    const long i = bestInArea(kf1, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (!keyframe_detail::predict(camera, kf1, T1w_via2, p->position(), *p, u, v, level, false)) continue;
+    const long i = keyframe_detail::bestInArea(kf1, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
     if (i >= 0 && !matches12[static_cast<std::size_t>(i)]) match1to2[static_cast<std::size_t>(i)] = static_cast<long>(j);
   }
   // kf1's points into kf2; keep the pairs both directions chose.
@@ -124,8 +128,8 @@ int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T1
     if (!p || p->isBad() || matches12[i] || match1to2[i] < 0) continue;
     float u, v;
     int level;
-    if (!predict(kf2, T2w_via1, p->position(), *p, u, v, level, false)) continue;
-    const long j = bestInArea(kf2, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (!keyframe_detail::predict(camera, kf2, T2w_via1, p->position(), *p, u, v, level, false)) continue;
+    const long j = keyframe_detail::bestInArea(kf2, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
     if (j != match1to2[i]) continue;
     matches12[i] = kf2.point(static_cast<std::size_t>(j));
     ++added;
@@ -133,7 +137,8 @@ int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T1
   return added;
 }
 
-int matchByProjection(const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
+template <CameraModel Camera>
+int matchByProjection(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
                       std::vector<MapPoint*>& matches, float radius) {
   std::set<MapPoint*, ById> alreadyMatched;
   for (MapPoint* p : matches)
@@ -143,8 +148,8 @@ int matchByProjection(const KeyFrame& kf, const SE3d& Tcw, const std::vector<Map
     if (!p || p->isBad() || alreadyMatched.count(p)) continue;
     float u, v;
     int level;
-    if (!predict(kf, Tcw, p->position(), *p, u, v, level, true)) continue;
-    const long i = bestInArea(kf, u, v, level, radius, p->descriptor(), kThLow, &matches);
+    if (!keyframe_detail::predict(camera, kf, Tcw, p->position(), *p, u, v, level, true)) continue;
+    const long i = keyframe_detail::bestInArea(kf, u, v, level, radius, p->descriptor(), kThLow, &matches);
     if (i < 0) continue;
     matches[static_cast<std::size_t>(i)] = p;
     alreadyMatched.insert(p);
@@ -153,4 +158,4 @@ int matchByProjection(const KeyFrame& kf, const SE3d& Tcw, const std::vector<Map
   return added;
 }
 
-}  // namespace orbis::loop
+}  // namespace orbis::matching

@@ -1,4 +1,5 @@
-// orbis/mapping/bundle_adjustment.hpp — local and full BA over the map (paper §III-C).
+// orbis/map/map_bundle_adjustment.hpp — local and full BA over the map (paper §III-C), shared by
+// local mapping and loop closing.
 //
 // Contract: localBundleAdjustment optimises the keyframe, its covisible keyframes and every point
 // they see, with the other keyframes observing those points fixed; two passes, the second without
@@ -6,13 +7,16 @@
 // under Map::mutex(), solves outside it (abortable through `abort`) and writes back under the
 // lock, skipping objects that went bad meanwhile. fullBundleAdjustment does the same over every
 // keyframe and point, the origin fixed, and returns the optimised values without writing them:
-// the loop closer merges them through the spanning tree.
+// the loop closer merges them through the spanning tree. Both run on the sensor's camera model and
+// robust kernel (Sensor::Camera, Sensor::RobustKernel): depth observations of an RGB-D sensor as
+// a whitened disparity, of a stereo pair as (uL, v, uR). Bodies: map_bundle_adjustment_impl.hpp.
 #pragma once
 
 #include <atomic>
 #include <map>
 
 #include "orbis/map/map.hpp"
+#include "orbis/sensor/sensor.hpp"
 
 namespace orbis {
 
@@ -21,7 +25,9 @@ struct LocalBundleAdjustmentStats {
   bool aborted = false;
 };
 
-LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::atomic<bool>* abort);
+template <SensorConfiguration Sensor>
+LocalBundleAdjustmentStats localBundleAdjustment(const typename Sensor::Camera& camera, Map& map, KeyFrame* kf,
+                                                 std::atomic<bool>* abort);
 
 struct FullBundleAdjustmentResult {
   std::map<KeyFrameId, SE3d> keyFramePoses;            // Tcw of every optimised keyframe
@@ -29,6 +35,10 @@ struct FullBundleAdjustmentResult {
   bool aborted = false;
 };
 
-FullBundleAdjustmentResult fullBundleAdjustment(Map& map, int iterations, std::atomic<bool>* abort);
+template <SensorConfiguration Sensor>
+FullBundleAdjustmentResult fullBundleAdjustment(const typename Sensor::Camera& camera, Map& map, int iterations,
+                                                std::atomic<bool>* abort);
 
 }  // namespace orbis
+
+#include "orbis/map/map_bundle_adjustment_impl.hpp"

@@ -1,20 +1,22 @@
-#include "orbis/mapping/bundle_adjustment.hpp"
+// orbis/map/map_bundle_adjustment_impl.hpp — bodies of map_bundle_adjustment.hpp.
+//
+// Contract: included by map_bundle_adjustment.hpp only; see there.
+#pragma once
 
 #include <map>
 #include <mutex>
 #include <set>
 #include <vector>
 
-#include "orbis/map/map_camera.hpp"
+#include "orbis/map/map_bundle_adjustment.hpp"
 #include "orbis/optim/slam_ba.hpp"
 
 namespace orbis {
 
-namespace {
+namespace map_ba_detail {
 
 // A BA problem copied out of the map as plain values (optim/slam_ba.hpp's input).
 struct BaSnapshot {
-  MapIntrinsics intrinsics;
   std::vector<KeyFrame*> keyFrames;  // pose index -> keyframe
   std::vector<SE3d> poses;
   std::vector<char> poseFixed;
@@ -26,8 +28,7 @@ struct BaSnapshot {
 
 // Builds the problem for `free` keyframes and `points`; keyframes outside `free` that observe the
 // points enter fixed. The origin keyframe is always fixed (gauge). Caller holds the map mutex.
-void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points) {
-  s.intrinsics = free.front()->intrinsics;
+inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points) {
   std::map<KeyFrame*, int, ById> poseOf;
   auto addPose = [&](KeyFrame* kf, bool fixed) {
     const int index = static_cast<int>(s.poses.size());
@@ -54,15 +55,19 @@ void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std:
   }
 }
 
-optim::BundleAdjustmentResult solve(BaSnapshot& s, const optim::BundleAdjustmentOptions& options) {
-  return visitCamera(s.intrinsics, [&](const auto& camera) {
-    return optim::bundleAdjustment(camera, s.poses, s.poseFixed, s.positions, s.observations, options);
-  });
+template <SensorConfiguration Sensor>
+optim::BundleAdjustmentResult solve(const typename Sensor::Camera& camera, BaSnapshot& s,
+                                    const optim::BundleAdjustmentOptions& options) {
+  return optim::bundleAdjustment<typename Sensor::RobustKernel>(camera, s.poses, s.poseFixed, s.positions,
+                                                                s.observations, options);
 }
 
-}  // namespace
+}  // namespace map_ba_detail
 
-LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::atomic<bool>* abort) {
+template <SensorConfiguration Sensor>
+LocalBundleAdjustmentStats localBundleAdjustment(const typename Sensor::Camera& camera, Map& map, KeyFrame* kf,
+                                                 std::atomic<bool>* abort) {
+  using namespace map_ba_detail;
   LocalBundleAdjustmentStats stats;
   BaSnapshot s;
   {
@@ -89,7 +94,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::at
   options.iterations = 5;
   options.refineIterations = 10;
   options.abortFlag = abort;
-  const optim::BundleAdjustmentResult result = solve(s, options);
+  const optim::BundleAdjustmentResult result = solve<Sensor>(camera, s, options);
   stats.aborted = result.robustPass.termination == optim::Termination::Aborted;
 
   std::lock_guard lock(map.mutex());
@@ -116,7 +121,10 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* kf, std::at
   return stats;
 }
 
-FullBundleAdjustmentResult fullBundleAdjustment(Map& map, int iterations, std::atomic<bool>* abort) {
+template <SensorConfiguration Sensor>
+FullBundleAdjustmentResult fullBundleAdjustment(const typename Sensor::Camera& camera, Map& map, int iterations,
+                                                std::atomic<bool>* abort) {
+  using namespace map_ba_detail;
   FullBundleAdjustmentResult result;
   BaSnapshot s;
   {
@@ -130,7 +138,7 @@ FullBundleAdjustmentResult fullBundleAdjustment(Map& map, int iterations, std::a
   options.iterations = iterations;
   options.refineIterations = 0;
   options.abortFlag = abort;
-  const optim::BundleAdjustmentResult solved = solve(s, options);
+  const optim::BundleAdjustmentResult solved = solve<Sensor>(camera, s, options);
   result.aborted = solved.robustPass.termination == optim::Termination::Aborted || (abort && abort->load());
   for (std::size_t i = 0; i < s.keyFrames.size(); ++i) result.keyFramePoses[s.keyFrames[i]->id] = s.poses[i];
   for (std::size_t i = 0; i < s.points.size(); ++i) result.pointPositions[s.points[i]->id] = s.positions[i];

@@ -1,28 +1,45 @@
-#include "orbis/tracking/map_matching.hpp"
+// orbis/map/map_matching_impl.hpp — bodies of the searches declared in map_matching.hpp.
+//
+// Contract: included by map_matching.hpp only; see there.
+#pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "orbis/map/map_matching.hpp"
+
 namespace orbis::matching {
 
-namespace {
+namespace detail {
 
 constexpr float kViewCosFrontal = 0.998f;
 
-float radiusForViewCos(float viewCos) { return viewCos > kViewCosFrontal ? 2.5f : 4.0f; }
+inline float radiusForViewCos(float viewCos) { return viewCos > kViewCosFrontal ? 2.5f : 4.0f; }
 
-}  // namespace
+// The camera's observation of a camera-frame point in front of it: (u, v) and, for a stereo
+// camera, the predicted right coordinate (-1 otherwise).
+template <CameraModel Camera>
+Eigen::Vector3d projectWithRight(const Camera& camera, const Eigen::Vector3d& pc) {
+  if constexpr (StereoCameraModel<Camera>) {
+    return camera.project(pc);
+  } else {
+    const Eigen::Vector2d uv = camera.project(pc);
+    return {uv.x(), uv.y(), -1.0};
+  }
+}
 
-bool projectIntoFrame(const MapPoint& point, const SE3d& Tcw, const MapIntrinsics& K, const ScaleLevels& levels,
-                      Projection& out) {
+}  // namespace detail
+
+template <CameraModel Camera>
+bool projectIntoFrame(const Camera& camera, const MapIntrinsics& bounds, const MapPoint& point, const SE3d& Tcw,
+                      const ScaleLevels& levels, Projection& out) {
   const Eigen::Vector3d pw = point.position();
   const Eigen::Vector3d pc = Tcw * pw;
   if (pc.z() <= 0) return false;
-  const double invZ = 1.0 / pc.z();
-  const double u = K.fx * pc.x() * invZ + K.cx;
-  const double v = K.fy * pc.y() * invZ + K.cy;
-  if (!K.inImage(u, v)) return false;
+  const Eigen::Vector3d obs = detail::projectWithRight(camera, pc);
+  const double u = obs.x(), v = obs.y();
+  if (!bounds.inImage(u, v)) return false;
   const Eigen::Vector3d po = pw - Tcw.inverse().translation();
   const float dist = static_cast<float>(po.norm());
   if (dist < point.minDistanceInvariance() || dist > point.maxDistanceInvariance()) return false;
@@ -31,30 +48,35 @@ bool projectIntoFrame(const MapPoint& point, const SE3d& Tcw, const MapIntrinsic
   if (viewCos < 0.5f) return false;
   out.u = static_cast<float>(u);
   out.v = static_cast<float>(v);
-  out.uRight = K.bf > 0 ? static_cast<float>(u - K.bf * invZ) : -1.f;
+  out.uRight = StereoCameraModel<Camera> ? static_cast<float>(obs.z()) : -1.f;
   out.level = point.predictScale(dist, levels.levels(), levels.logFactor());
   out.viewCos = viewCos;
   return true;
 }
 
-int matchFromLastFrame(Frame& current, const Frame& last, float radius, bool checkOrientation) {
+template <CameraModel Camera>
+int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float radius, bool checkOrientation) {
   const FrameFeatures& cf = *current.features;
   const ScaleLevels& levels = cf.scales;
   RotationHistogram hist;
   const SE3d& Tcw = current.Tcw;
   const Eigen::Vector3d tlc = last.Tcw * current.cameraCenter();  // current centre in last's frame
-  const bool stereo = current.intrinsics.bf > 0;
-  const bool forward = stereo && tlc.z() > current.intrinsics.bf / current.intrinsics.fx;
-  const bool backward = stereo && -tlc.z() > current.intrinsics.bf / current.intrinsics.fx;
+  // A stereo camera that moved more than its baseline forward (backward) sees last's points at
+  // finer (coarser) levels only.
+  constexpr bool kStereo = StereoCameraModel<Camera>;
+  double baseline = 0;
+  if constexpr (kStereo) baseline = current.camera->bf() / pinholeOf(*current.camera).fx;
+  const bool forward = kStereo && tlc.z() > baseline;
+  const bool backward = kStereo && -tlc.z() > baseline;
   int matches = 0;
   for (std::size_t i = 0; i < last.size(); ++i) {
     MapPoint* p = last.points[i];
     if (!p || last.outlier[i] || p->isBad()) continue;
     const Eigen::Vector3d pc = Tcw * p->position();
     if (pc.z() <= 0) continue;
-    const double invZ = 1.0 / pc.z();
-    const float u = static_cast<float>(current.intrinsics.fx * pc.x() * invZ + current.intrinsics.cx);
-    const float v = static_cast<float>(current.intrinsics.fy * pc.y() * invZ + current.intrinsics.cy);
+    const Eigen::Vector3d obs = detail::projectWithRight(*current.camera, pc);
+    const float u = static_cast<float>(obs.x());
+    const float v = static_cast<float>(obs.y());
     if (!current.intrinsics.inImage(u, v)) continue;
     const int lastOctave = last.features->keypointsUn[i].octave;
     const float r = radius * levels.scale[static_cast<std::size_t>(lastOctave)];
@@ -62,12 +84,12 @@ int matchFromLastFrame(Frame& current, const Frame& last, float radius, bool che
     if (forward) { minLevel = lastOctave; maxLevel = levels.levels() - 1; }
     else if (backward) { minLevel = 0; maxLevel = lastOctave; }
     const auto candidates = cf.grid.featuresInArea(u, v, r, std::max(0, minLevel), maxLevel);
-    const float uRightPred = static_cast<float>(u - current.intrinsics.bf * invZ);
+    const float uRightPred = static_cast<float>(obs.z());
     int bestDist = 256;
     std::size_t best = 0;
     for (std::size_t j : candidates) {
       if (MapPoint* q = current.points[j]; q && q->observationCount() > 0) continue;
-      if (stereo && cf.uRight[j] >= 0 && std::abs(uRightPred - cf.uRight[j]) > r) continue;
+      if (kStereo && cf.uRight[j] >= 0 && std::abs(uRightPred - cf.uRight[j]) > r) continue;
       const int d = hammingDistance(p->descriptor(), cf.descriptors[j]);
       if (d < bestDist) { bestDist = d; best = j; }
     }
@@ -82,7 +104,8 @@ int matchFromLastFrame(Frame& current, const Frame& last, float radius, bool che
   return matches;
 }
 
-int matchLocalPoints(Frame& frame, const std::vector<MapPoint*>& points, const std::vector<Projection>& projections,
+template <CameraModel Camera>
+int matchLocalPoints(Frame<Camera>& frame, const std::vector<MapPoint*>& points, const std::vector<Projection>& projections,
                      float radiusFactor, float ratio) {
   const FrameFeatures& f = *frame.features;
   int matches = 0;
@@ -90,7 +113,7 @@ int matchLocalPoints(Frame& frame, const std::vector<MapPoint*>& points, const s
     MapPoint* p = points[k];
     if (!p || p->isBad()) continue;
     const Projection& pr = projections[k];
-    const float r = radiusFactor * radiusForViewCos(pr.viewCos) * f.scales.scale[static_cast<std::size_t>(pr.level)];
+    const float r = radiusFactor * detail::radiusForViewCos(pr.viewCos) * f.scales.scale[static_cast<std::size_t>(pr.level)];
     const auto candidates = f.grid.featuresInArea(pr.u, pr.v, r, pr.level - 1, pr.level);
     int bestDist = 256, secondDist = 256, bestLevel = -1, secondLevel = -1;
     std::size_t best = 0;
@@ -114,7 +137,8 @@ int matchLocalPoints(Frame& frame, const std::vector<MapPoint*>& points, const s
   return matches;
 }
 
-int matchByBow(const KeyFrame& kf, const Frame& frame, std::vector<MapPoint*>& out, float ratio, bool checkOrientation) {
+template <CameraModel Camera>
+int matchByBow(const KeyFrame& kf, const Frame<Camera>& frame, std::vector<MapPoint*>& out, float ratio, bool checkOrientation) {
   const FrameFeatures& kff = kf.features();
   const FrameFeatures& ff = *frame.features;
   out.assign(frame.size(), nullptr);
@@ -151,7 +175,8 @@ int matchByBow(const KeyFrame& kf, const Frame& frame, std::vector<MapPoint*>& o
   return matches;
 }
 
-int matchFromKeyFrame(Frame& frame, const KeyFrame& kf, const std::set<MapPoint*, ById>& alreadyFound, float radius,
+template <CameraModel Camera>
+int matchFromKeyFrame(Frame<Camera>& frame, const KeyFrame& kf, const std::set<MapPoint*, ById>& alreadyFound, float radius,
                       int maxDistance) {
   const FrameFeatures& f = *frame.features;
   const Eigen::Vector3d center = frame.cameraCenter();
@@ -162,8 +187,9 @@ int matchFromKeyFrame(Frame& frame, const KeyFrame& kf, const std::set<MapPoint*
     if (!p || p->isBad() || alreadyFound.count(p)) continue;
     const Eigen::Vector3d pc = frame.Tcw * p->position();
     if (pc.z() <= 0) continue;
-    const float u = static_cast<float>(frame.intrinsics.fx * pc.x() / pc.z() + frame.intrinsics.cx);
-    const float v = static_cast<float>(frame.intrinsics.fy * pc.y() / pc.z() + frame.intrinsics.cy);
+    const Eigen::Vector2d uv = pinholeOf(*frame.camera).project(pc);
+    const float u = static_cast<float>(uv.x());
+    const float v = static_cast<float>(uv.y());
     if (!frame.intrinsics.inImage(u, v)) continue;
     const float dist = static_cast<float>((p->position() - center).norm());
     if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;
@@ -187,14 +213,15 @@ int matchFromKeyFrame(Frame& frame, const KeyFrame& kf, const std::set<MapPoint*
   return matches;
 }
 
-std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const KeyFrame& kf1, const KeyFrame& kf2,
-                                                                      const Eigen::Matrix3d& F12, bool onlyStereo) {
+template <CameraModel Camera>
+std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Camera& camera, const KeyFrame& kf1,
+                                                                      const KeyFrame& kf2, const Eigen::Matrix3d& F12,
+                                                                      bool onlyStereo) {
   const FrameFeatures& f1 = kf1.features();
   const FrameFeatures& f2 = kf2.features();
   // Epipole of kf1's centre in kf2: keypoints too close to it have unreliable depth.
   const Eigen::Vector3d c1in2 = kf2.Tcw() * kf1.cameraCenter();
-  const Eigen::Vector2d epipole(kf2.intrinsics.fx * c1in2.x() / c1in2.z() + kf2.intrinsics.cx,
-                                kf2.intrinsics.fy * c1in2.y() / c1in2.z() + kf2.intrinsics.cy);
+  const Eigen::Vector2d epipole = pinholeOf(camera).project(c1in2);
   std::vector<std::uint8_t> taken2(kf2.size(), 0);
   std::vector<long> matched1(kf1.size(), -1);
   RotationHistogram hist;
@@ -210,7 +237,7 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
       const Keypoint& k1 = f1.keypointsUn[i];
       // x2ᵀ F12 x1 = 0, so the epipolar line of x1 in kf2 is F12 x1; candidates share the node.
       const Eigen::Vector3d line = F12 * Eigen::Vector3d(k1.u, k1.v, 1.0);
-      const long best = detail::bestEpipolarPartner(
+      const long best = orbis::detail::bestEpipolarPartner(
           f1, i, f2, b.featuresOf(ib), line, epipole, onlyStereo,
           [&](std::size_t j) { return kf2.point(j) != nullptr || taken2[j]; }, HammingDistance{});
       if (best >= 0) {
@@ -231,9 +258,9 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
   return out;
 }
 
-int fuse(KeyFrame& kf, const std::vector<MapPoint*>& points, float radius) {
+template <CameraModel Camera>
+int fuse(const Camera& camera, KeyFrame& kf, const std::vector<MapPoint*>& points, float radius) {
   const FrameFeatures& f = kf.features();
-  const MapIntrinsics& K = kf.intrinsics;
   const SE3d Tcw = kf.Tcw();
   const Eigen::Vector3d center = kf.cameraCenter();
   int fused = 0;
@@ -241,11 +268,10 @@ int fuse(KeyFrame& kf, const std::vector<MapPoint*>& points, float radius) {
     if (!p || p->isBad() || p->isObservedBy(&kf)) continue;
     const Eigen::Vector3d pc = Tcw * p->position();
     if (pc.z() <= 0) continue;
-    const double invZ = 1.0 / pc.z();
-    const double u = K.fx * pc.x() * invZ + K.cx;
-    const double v = K.fy * pc.y() * invZ + K.cy;
-    if (!K.inImage(u, v)) continue;
-    const double ur = u - K.bf * invZ;
+    const Eigen::Vector3d obs = detail::projectWithRight(camera, pc);
+    const double u = obs.x(), v = obs.y();
+    if (!kf.intrinsics.inImage(u, v)) continue;
+    const double ur = obs.z();
     const Eigen::Vector3d po = p->position() - center;
     const float dist = static_cast<float>(po.norm());
     if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;

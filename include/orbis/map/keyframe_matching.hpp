@@ -1,4 +1,5 @@
-// orbis/loop/loop_matching.hpp — the descriptor searches of loop closing (ORB-SLAM §VII-B, C).
+// orbis/map/keyframe_matching.hpp — the keyframe-to-keyframe descriptor searches of loop closing
+// (ORB-SLAM §VII-B, C), beside map_matching.hpp in the matching layer below the thread modules.
 //
 // Contract: every search compares 256-bit ORB descriptors by Hamming distance between a keyframe
 // and map points or another keyframe, writes its matches into one slot per keypoint of the
@@ -17,17 +18,23 @@
 
 #include <vector>
 
+#include "orbis/camera/camera_model.hpp"
 #include "orbis/map/map.hpp"
 
-namespace orbis::loop {
+namespace orbis::matching {
 
 int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<MapPoint*>& matches12,
                         float ratio = 0.75f);
 
-int matchByRelativePose(const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
-                        float radius = 7.5f);
+// Projections go through `camera`'s pinhole (both keyframes share the sensor's camera).
+template <CameraModel Camera>
+int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12,
+                        std::vector<MapPoint*>& matches12, float radius = 7.5f);
 
-int matchByProjection(const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
+template <CameraModel Camera>
+int matchByProjection(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
                       std::vector<MapPoint*>& matches, float radius = 10.0f);
 
-}  // namespace orbis::loop
+}  // namespace orbis::matching
+
+#include "orbis/map/keyframe_matching_impl.hpp"

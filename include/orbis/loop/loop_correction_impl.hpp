@@ -1,35 +1,42 @@
-// The loop correction half of LoopCloser: loop fusion, essential graph, full BA and its merge.
+// orbis/loop/loop_correction_impl.hpp — the loop correction half of LoopCloser<Sensor>: loop
+// fusion, essential graph, full BA and its merge.
+//
+// Contract: included by loop_closer.hpp only; see there.
+#pragma once
+
 #include <algorithm>
 #include <cstdio>
 
 #include "orbis/loop/loop_closer.hpp"
-#include "orbis/mapping/bundle_adjustment.hpp"
-#include "orbis/mapping/local_mapper.hpp"
+#include "orbis/map/map_bundle_adjustment.hpp"
+#include "orbis/map/map_matching.hpp"
 #include "orbis/optim/pose_graph.hpp"
-#include "orbis/tracking/map_matching.hpp"
 
 namespace orbis {
 
-namespace {
+namespace loop_detail {
 
-MapPoint* followReplacements(MapPoint* p) {
+inline MapPoint* followReplacements(MapPoint* p) {
   while (p && p->isBad() && p->replacement()) p = p->replacement();
   return p && !p->isBad() ? p : nullptr;
 }
 
-}  // namespace
+}  // namespace loop_detail
 
-void LoopCloser::pauseMapping() {
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::pauseMapping() {
   if (!options_.threaded || !mapper_) return;  // deterministic: mapping is idle between calls
   mapper_->requestStop();
-  while (!mapper_->isStopped() && !finish_) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  while (!mapper_->isStopped() && !worker_.finishing()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
-void LoopCloser::resumeMapping() {
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::resumeMapping() {
   if (options_.threaded && mapper_) mapper_->release();
 }
 
-void LoopCloser::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
   // A full BA still running would merge a map this correction has already moved.
   stopFullBundleAdjustment();
   pauseMapping();
@@ -64,7 +71,7 @@ void LoopCloser::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
 
     // Loop fusion: the current keyframe's matches become the loop side's points.
     for (std::size_t i = 0; i < loop.matches.size(); ++i) {
-      MapPoint* loopPoint = followReplacements(loop.matches[i]);
+      MapPoint* loopPoint = loop_detail::followReplacements(loop.matches[i]);
       if (!loopPoint) continue;
       MapPoint* own = kf->point(i);
       if (own && !own->isBad()) {
@@ -78,9 +85,9 @@ void LoopCloser::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
     // Duplicates in the neighbourhood, now that both sides agree.
     std::vector<MapPoint*> loopPoints;
     for (MapPoint* p : loop.loopPoints)
-      if (MapPoint* q = followReplacements(p)) loopPoints.push_back(q);
+      if (MapPoint* q = loop_detail::followReplacements(p)) loopPoints.push_back(q);
     for (KeyFrame* k : connected)
-      if (!k->isBad()) matching::fuse(*k, loopPoints, 4.0f);
+      if (!k->isBad()) matching::fuse(camera_, *k, loopPoints, 4.0f);
 
     // Links the fusion created between the two sides of the loop.
     for (KeyFrame* k : connected) {
@@ -112,7 +119,8 @@ void LoopCloser::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
   if (options_.fullBundleAdjustment) startFullBundleAdjustment();
 }
 
-void LoopCloser::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected,
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected,
                                         const LinkMap& loopLinks, const PointCorrectors& correctedBy) {
   std::vector<KeyFrame*> keyFrames;
   std::vector<SE3d> poses, before;
@@ -178,14 +186,16 @@ void LoopCloser::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const Po
   for (MapPoint* p : map_.mapPoints()) p->updateNormalAndDepth();
 }
 
-void LoopCloser::stopFullBundleAdjustment() {
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::stopFullBundleAdjustment() {
   if (!fullBaThread_.joinable()) return;
   abortFullBa_ = true;
   fullBaThread_.join();
   abortFullBa_ = false;
 }
 
-void LoopCloser::startFullBundleAdjustment() {
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::startFullBundleAdjustment() {
   stopFullBundleAdjustment();
   fullBaRunning_ = true;
   if (!options_.threaded) {
@@ -199,11 +209,12 @@ void LoopCloser::startFullBundleAdjustment() {
   });
 }
 
-void LoopCloser::runFullBundleAdjustment() {
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::runFullBundleAdjustment() {
   FullBundleAdjustmentResult result;
   {
     ScopedStage stage(timer_, "loop: full BA");
-    result = fullBundleAdjustment(map_, options_.fullBundleAdjustmentIterations, &abortFullBa_);
+    result = fullBundleAdjustment<Sensor>(camera_, map_, options_.fullBundleAdjustmentIterations, &abortFullBa_);
   }
   if (result.aborted || abortFullBa_) return;
   pauseMapping();

@@ -1,8 +1,11 @@
-// orbis/tracking/frame.hpp — the frame being tracked: features, pose and map-point matches.
+// orbis/map/frame.hpp — the frame being tracked: features, pose and map-point matches.
 //
-// Contract: a Frame is built once from a sensor's images (system/frame_builder.hpp) and then
+// Contract: a Frame<Camera> is built once per input by the sensor's feature builder and then
 // only its pose, its matches and their outlier flags change. Features are shared, immutable,
-// with the keyframe it may become. Sensor-agnostic: uRight < 0 marks a monocular keypoint.
+// with the keyframe it may become. The camera is the sensor's compile-time model (owned by the
+// SLAM system, outliving the frame); `intrinsics` records the undistorted image bounds
+// keypoints fall in and the numbers a keyframe's map-file record keeps. uRight < 0 marks a
+// keypoint without a stereo/depth coordinate.
 #pragma once
 
 #include <cstdint>
@@ -10,16 +13,18 @@
 #include <vector>
 
 #include "orbis/bow/bow_vector.hpp"
+#include "orbis/camera/camera_model.hpp"
 #include "orbis/map/key_frame.hpp"
 
 namespace orbis {
 
+template <CameraModel Camera>
 struct Frame {
   std::uint64_t index = 0;
   double timestamp = 0;
   std::shared_ptr<const FrameFeatures> features;
+  const Camera* camera = nullptr;
   MapIntrinsics intrinsics;
-  bool isRgbd = false;  // depth from a sensor rather than stereo matching (wider search windows)
 
   bow::BowVector bow;
   bow::FeatureVector featureVector;
@@ -42,18 +47,14 @@ struct Frame {
     return n;
   }
   bool isStereo(std::size_t i) const { return features->uRight[i] >= 0; }
+  // Close points (paper §III-A) are trusted from one frame; a monocular camera has none.
   bool isClose(std::size_t i) const {
     const float d = features->depth[i];
-    return d > 0 && d < intrinsics.closeDepth;
+    return d > 0 && d < camera->closeDepthThreshold();
   }
   // World point of keypoint i from its depth (stereo or RGB-D), using the current pose.
-  bool unprojectStereo(std::size_t i, Eigen::Vector3d& world) const {
-    const float z = features->depth[i];
-    if (!(z > 0)) return false;
-    const Keypoint& k = features->keypointsUn[i];
-    const Eigen::Vector3d pc((k.u - intrinsics.cx) * z / intrinsics.fx, (k.v - intrinsics.cy) * z / intrinsics.fy, z);
-    world = Tcw.inverse() * pc;
-    return true;
+  bool pointFromDepth(std::size_t i, Eigen::Vector3d& world) const {
+    return orbis::pointFromDepth(*camera, *features, i, Tcw, world);
   }
 };
 

@@ -1,9 +1,14 @@
-// orbis/system/sensor.hpp — sensor configurations: the compile-time traits Slam<Sensor> runs on.
+// orbis/sensor/sensor.hpp — sensor configurations: the compile-time traits the whole pipeline
+// runs on (frames, tracking, local mapping, loop closing, bundle adjustment, Slam<Sensor>).
 //
-// Contract: a sensor configuration names its camera model, its feature extractor, the input one
-// frame brings, and how that input becomes FrameFeatures (paper Fig. 2b). Everything after
-// feature extraction is sensor-agnostic. A new sensor is one more struct meeting
-// SensorConfiguration, not a fork of the pipeline.
+// Contract: a sensor configuration names its camera model (a CameraModel; metric sensors a
+// StereoCameraModel), the input one frame brings, how that input becomes FrameFeatures (paper
+// Fig. 2b), the robust kernel every bundle adjustment uses (an optim::RobustKernel), and three
+// facts the pipeline branches on at compile time: kKind, kMetricScale (depth from one frame:
+// one-frame bootstrap, SE(3) loops) and kDepthFromSensor (an RGB-D sensor rather than a stereo
+// pair: wider search windows, the depth residual). A new sensor is one more struct meeting
+// SensorConfiguration, instantiated from the headers (see tests/system/custom_sensor_test.cpp),
+// not a fork of the pipeline.
 #pragma once
 
 #include <algorithm>
@@ -17,6 +22,7 @@
 #include "orbis/features/frame_features.hpp"
 #include "orbis/features/orb_extractor.hpp"
 #include "orbis/features/stereo_matcher.hpp"
+#include "orbis/optim/robust_kernel.hpp"
 
 namespace orbis {
 
@@ -35,10 +41,13 @@ template <class S>
 concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, const typename S::Input& input) {
   typename S::Camera;
   typename S::Input;
+  typename S::RobustKernel;
   { S::kKind } -> std::convertible_to<SensorKind>;
   { S::kMetricScale } -> std::convertible_to<bool>;
+  { S::kDepthFromSensor } -> std::convertible_to<bool>;
   { builder.build(input) } -> std::same_as<FrameFeatures>;
-} && CameraModel<typename S::Camera>;
+} && CameraModel<typename S::Camera> && optim::RobustKernel<typename S::RobustKernel> &&
+    (!S::kMetricScale || StereoCameraModel<typename S::Camera>);
 
 // A rectified stereo pair: ORB on both images, then stereo matching along rows (§III-A); the
 // two extractions run in parallel. OrbParams::rightFeaturesFactor (settings key
@@ -57,6 +66,7 @@ concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, cons
 struct Stereo {
   using Camera = RectifiedStereoCamera<double>;
   using Input = StereoInput;
+  using RobustKernel = optim::HuberKernel;  // ORB-SLAM2's, with χ² 95% thresholds
   static constexpr SensorKind kKind = SensorKind::Stereo;
   static constexpr bool kMetricScale = true;
   static constexpr bool kDepthFromSensor = false;
@@ -82,6 +92,7 @@ struct Stereo {
 struct Rgbd {
   using Camera = RgbdCamera<double>;
   using Input = RgbdInput;
+  using RobustKernel = optim::HuberKernel;
   static constexpr SensorKind kKind = SensorKind::Rgbd;
   static constexpr bool kMetricScale = true;
   static constexpr bool kDepthFromSensor = true;

@@ -1,4 +1,4 @@
-// orbis/loop/map_covisibility.hpp — the map's covisibility graph in the shape the keyframe
+// orbis/map/map_covisibility.hpp — the map's covisibility graph in the shape the keyframe
 // database's place queries ask for (bow::CovisibilityGraph).
 //
 // Contract: a view of a Map, answering by keyframe id; unknown and bad keyframes have no
@@ -10,7 +10,7 @@
 #include "orbis/bow/keyframe_database.hpp"
 #include "orbis/map/map.hpp"
 
-namespace orbis::loop {
+namespace orbis {
 
 class MapCovisibility {
  public:
@@ -38,4 +38,4 @@ class MapCovisibility {
 
 static_assert(bow::CovisibilityGraph<MapCovisibility>);
 
-}  // namespace orbis::loop
+}  // namespace orbis

@@ -1,0 +1,243 @@
+// orbis/loop/loop_closer_impl.hpp — LoopCloser<Sensor>'s queue, detection and relative pose.
+//
+// Contract: included by loop_closer.hpp only; see there.
+#pragma once
+
+#include <algorithm>
+#include <cstdio>
+
+#include "orbis/loop/loop_closer.hpp"
+#include "orbis/loop/relative_pose.hpp"
+#include "orbis/map/keyframe_matching.hpp"
+#include "orbis/map/map_covisibility.hpp"
+
+namespace orbis {
+
+template <SensorConfiguration Sensor>
+LoopCloser<Sensor>::LoopCloser(const Camera& camera, Map& map, LocalMappingControl* mapper,
+                               bow::KeyframeDatabase& database, LoopCloserOptions options, StageTimer* timer)
+    : camera_(camera),
+      map_(map),
+      mapper_(mapper),
+      database_(database),
+      options_(std::move(options)),
+      timer_(timer),
+      rng_(options_.seed) {
+  if (options_.threaded) worker_.start([this] {
+      while (!worker_.finishing() && processOne()) {
+      }
+    });
+}
+
+template <SensorConfiguration Sensor>
+LoopCloser<Sensor>::~LoopCloser() { shutdown(); }
+
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::shutdown() {
+  worker_.stop();
+  stopFullBundleAdjustment();
+}
+
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::insertKeyFrame(KeyFrame* kf) {
+  worker_.push(kf);
+}
+
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::runUntilIdle() {
+  while (processOne()) {
+  }
+}
+
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::waitUntilIdle() {
+  worker_.waitUntilIdle([this] { runUntilIdle(); }, [this] { return !fullBaRunning_.load(); });
+}
+
+template <SensorConfiguration Sensor>
+std::vector<LoopClosureEvent> LoopCloser<Sensor>::closures() const {
+  std::lock_guard lock(eventsMutex_);
+  return events_;
+}
+
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::report(const std::string& line) const {
+  if (options_.log) {
+    options_.log(line);
+  } else {
+    std::fprintf(stderr, "%s\n", line.c_str());  // stdout may carry a --json report
+  }
+}
+
+template <SensorConfiguration Sensor>
+bool LoopCloser<Sensor>::processOne() {
+  const std::optional<KeyFrame*> next = worker_.pop();
+  if (!next) return false;
+  KeyFrame* kf = *next;
+  LoopCandidate loop;
+  bool found = false;
+  {
+    ScopedStage stage(timer_, "loop: detection");
+    std::lock_guard lock(map_.mutex());
+    dropBadKeyFrames();
+    if (kf->isBad()) return true;
+    kf->setProtected(true);  // local mapping must not cull it while we look at it
+    const std::vector<KeyFrame*> candidates = detectConsistentCandidates(kf);
+    database_.add(kf->id, kf->bowVector());
+    indexed_.push_back(kf);
+    if (!candidates.empty()) {
+      for (KeyFrame* c : candidates) c->setProtected(true);
+      found = computeRelativePose(kf, candidates, loop);
+      for (KeyFrame* c : candidates)
+        if (c != loop.loopKeyFrame || !found) c->setProtected(false);
+    }
+    if (!found) kf->setProtected(false);
+  }
+  if (found) {
+    ScopedStage stage(timer_, "loop: correction");
+    correctLoop(kf, loop);
+  }
+  return true;
+}
+
+template <SensorConfiguration Sensor>
+void LoopCloser<Sensor>::dropBadKeyFrames() {
+  std::erase_if(indexed_, [this](KeyFrame* k) {
+    if (!k->isBad()) return false;
+    database_.erase(k->id);
+    return true;
+  });
+}
+
+template <SensorConfiguration Sensor>
+std::vector<KeyFrame*> LoopCloser<Sensor>::detectConsistentCandidates(KeyFrame* kf) {
+  // Too soon after a loop, or too small a map: nothing to close.
+  if ((anyLoop_ && kf->id < lastLoopKeyFrame_ + static_cast<KeyFrameId>(options_.keyFramesAfterLoop)) ||
+      map_.keyFrameCount() <= static_cast<std::size_t>(options_.keyFramesAfterLoop)) {
+    consistentGroups_.clear();
+    return {};
+  }
+  const MapCovisibility graph(map_);
+  std::vector<KeyFrame*> candidates;
+  for (const bow::PlaceCandidate& c : database_.detectLoopCandidates(kf->id, kf->bowVector(), graph)) {
+    KeyFrame* k = map_.keyFrame(c.keyframe);
+    if (k && !k->isBad()) candidates.push_back(k);
+  }
+  if (candidates.empty()) {
+    consistentGroups_.clear();
+    return {};
+  }
+  // ORB-SLAM's consistency check: a candidate's group (itself and its covisible keyframes) must
+  // share a keyframe with a group that was consistent for the previous keyframes.
+  std::vector<ConsistentGroup> current;
+  std::vector<char> groupContinued(consistentGroups_.size(), 0);
+  std::vector<KeyFrame*> enough;
+  for (KeyFrame* candidate : candidates) {
+    ConsistentGroup group;
+    group.members.insert(candidate->id);
+    for (KeyFrame* n : candidate->covisibles())
+      if (!n->isBad()) group.members.insert(n->id);
+    bool consistentWithSome = false, added = false;
+    for (std::size_t g = 0; g < consistentGroups_.size(); ++g) {
+      const auto& previous = consistentGroups_[g].members;
+      const bool shares = std::any_of(group.members.begin(), group.members.end(),
+                                      [&](KeyFrameId id) { return previous.count(id) != 0; });
+      if (!shares) continue;
+      consistentWithSome = true;
+      const int consistency = consistentGroups_[g].consistency + 1;
+      if (!groupContinued[g]) {
+        current.push_back({group.members, consistency});
+        groupContinued[g] = 1;
+      }
+      if (consistency >= options_.consistencyThreshold && !added) {
+        enough.push_back(candidate);
+        added = true;
+      }
+    }
+    if (!consistentWithSome) current.push_back({group.members, 0});
+  }
+  consistentGroups_ = std::move(current);
+  return enough;
+}
+
+namespace loop_detail {
+
+inline loop::PointPair makePair(const KeyFrame& kf1, std::size_t i1, const KeyFrame& kf2, std::size_t i2) {
+  const Keypoint& k1 = kf1.features().keypointsUn[i1];
+  const Keypoint& k2 = kf2.features().keypointsUn[i2];
+  loop::PointPair p;
+  p.p1 = kf1.Tcw() * kf1.point(i1)->position();
+  p.p2 = kf2.Tcw() * kf2.point(i2)->position();
+  p.obs1 = {k1.u, k1.v};
+  p.obs2 = {k2.u, k2.v};
+  p.information1 = kf1.features().scales.invSigma2[static_cast<std::size_t>(k1.octave)];
+  p.information2 = kf2.features().scales.invSigma2[static_cast<std::size_t>(k2.octave)];
+  return p;
+}
+
+// Point pairs from per-keypoint matches (kf1 keypoint i -> kf2 map point), with kf1's indices.
+inline void pairsFromMatches(const KeyFrame& kf1, const KeyFrame& kf2, const std::vector<MapPoint*>& matches,
+                      std::vector<loop::PointPair>& pairs, std::vector<std::size_t>& index1) {
+  pairs.clear();
+  index1.clear();
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    MapPoint* p2 = matches[i];
+    MapPoint* p1 = kf1.point(i);
+    if (!p2 || !p1 || p1->isBad() || p2->isBad()) continue;
+    const long i2 = p2->indexIn(&kf2);
+    if (i2 < 0) continue;
+    pairs.push_back(makePair(kf1, i, kf2, static_cast<std::size_t>(i2)));
+    index1.push_back(i);
+  }
+}
+
+}  // namespace loop_detail
+
+template <SensorConfiguration Sensor>
+bool LoopCloser<Sensor>::computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out) {
+  loop::RelativePoseRansacOptions ransac;
+  ransac.minInliers = options_.minPoseInliers;
+  const PinholeCamera<double>& pinhole = pinholeOf(camera_);
+  std::vector<loop::PointPair> pairs;
+  std::vector<std::size_t> index1;
+  for (KeyFrame* candidate : candidates) {
+    std::vector<MapPoint*> matches;
+    const int bowMatches = matching::matchKeyFramesByBow(*kf, *candidate, matches);
+    if (bowMatches < options_.minBowMatches) continue;
+    loop_detail::pairsFromMatches(*kf, *candidate, matches, pairs, index1);
+    const loop::RelativePoseEstimate estimate = loop::estimateRelativePoseRansac(pairs, pinhole, ransac, rng_);
+    if (!estimate.found) continue;
+    // Guided matching from the RANSAC inliers, then refinement over every match.
+    std::vector<MapPoint*> guided(kf->size(), nullptr);
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      if (estimate.inliers[k]) guided[index1[k]] = matches[index1[k]];
+    SE3d T12 = estimate.T12;
+    matching::matchByRelativePose(camera_, *kf, *candidate, T12, guided);
+    loop_detail::pairsFromMatches(*kf, *candidate, guided, pairs, index1);
+    std::vector<char> inliers(pairs.size(), 1);
+    if (loop::refineRelativePose(pairs, pinhole, T12, inliers) < options_.minPoseInliers) continue;
+    out.loopKeyFrame = candidate;
+    out.correctedTcw = T12 * candidate->Tcw();
+    out.matches.assign(kf->size(), nullptr);
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      if (inliers[k]) out.matches[index1[k]] = guided[index1[k]];
+    break;
+  }
+  if (!out.loopKeyFrame) return false;
+  // More matches from the loop keyframe's neighbourhood, seen from the corrected pose.
+  std::vector<KeyFrame*> neighbourhood = out.loopKeyFrame->covisibles();
+  neighbourhood.insert(neighbourhood.begin(), out.loopKeyFrame);
+  std::set<MapPoint*, ById> seen;
+  for (KeyFrame* k : neighbourhood) {
+    if (k->isBad()) continue;
+    for (MapPoint* p : k->points())
+      if (p && !p->isBad() && seen.insert(p).second) out.loopPoints.push_back(p);
+  }
+  matching::matchByProjection(camera_, *kf, out.correctedTcw, out.loopPoints, out.matches);
+  out.matched = static_cast<int>(std::count_if(out.matches.begin(), out.matches.end(), [](MapPoint* p) { return p; }));
+  if (out.matched >= options_.minLoopMatches) return true;
+  out = LoopCandidate{};
+  return false;
+}
+
+}  // namespace orbis

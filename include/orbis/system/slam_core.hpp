@@ -1,0 +1,124 @@
+// orbis/system/slam_core.hpp — SlamCore<Sensor>: the SLAM system after feature extraction.
+//
+// Contract: owns the map, the keyframe database and the three stages of the paper for one
+// sensor configuration: Tracker<Sensor> on the caller's thread, LocalMapper<Sensor> and
+// LoopCloser<Sensor> on their own threads (threaded mode) or run inline in a fixed order after
+// each new keyframe (deterministic mode: bit-identical results), Relocaliser<Sensor> for lost
+// tracking. The camera model is held here once; every stage keeps a reference to it. Bodies:
+// slam_core_impl.hpp; the built-in sensors are compiled in src/system/slam_core.cpp.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "orbis/bow/keyframe_database.hpp"
+#include "orbis/io/trajectory.hpp"
+#include "orbis/loop/loop_closer.hpp"
+#include "orbis/map/map.hpp"
+#include "orbis/mapping/local_mapper.hpp"
+#include "orbis/sensor/sensor.hpp"
+#include "orbis/tracking/relocaliser.hpp"
+#include "orbis/tracking/tracker.hpp"
+#include "orbis/util/timing.hpp"
+
+namespace orbis {
+
+struct SlamOptions {
+  bool deterministic = false;     // inline stages in a fixed order (the tests use it)
+  bool localisationOnly = false;  // tracking only, against the existing map (§III-F)
+  bool loopClosing = true;
+  double fps = 30;                // frame rate: the keyframe rule's "max frames" (ORB-SLAM2)
+  std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
+};
+
+struct SlamStats {
+  std::size_t frames = 0, tracked = 0, lost = 0, keyFrames = 0, mapPoints = 0;
+  std::size_t loopClosures = 0;
+};
+
+// Everything after feature extraction: tracking, local mapping, loop closing and relocalisation
+// over one Map, all on Sensor's camera model, kernel and trait.
+template <SensorConfiguration Sensor>
+class SlamCore {
+ public:
+  using Camera = typename Sensor::Camera;
+
+  SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options);
+  ~SlamCore();
+  SlamCore(const SlamCore&) = delete;
+  SlamCore& operator=(const SlamCore&) = delete;
+
+  TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp);
+  void shutdown();
+
+  Trajectory trajectory() const;          // every tracked frame, camera-to-world
+  Trajectory keyFrameTrajectory() const;  // every good keyframe, camera-to-world
+  std::vector<Eigen::Vector3f> mapPointCloud() const;
+  SlamStats stats() const;
+  TrackingState state() const { return tracker_->state(); }
+  void setLocalisationOnly(bool on);
+
+  // Map files (io/map_file.hpp). saveMap waits for local mapping to finish its queue. loadMap
+  // needs a core that has not tracked yet; tracking then starts lost and relocalises in the map.
+  void saveMap(const std::filesystem::path& file);
+  void loadMap(const std::filesystem::path& file);
+  static constexpr SensorKind sensorKind() { return Sensor::kKind; }
+  // Relocalisation attempts and successes; keyframes loaded from a map file.
+  RelocalisationStats relocalisationStats() const;
+  std::size_t loadedKeyFrames() const { return loadedKeyFrames_; }
+
+  Map& map() { return map_; }
+  const Map& map() const { return map_; }
+  StageTimer& timer() { return timer_; }
+  const StageTimer& timer() const { return timer_; }
+  const Camera& camera() const { return camera_; }
+  // What the map file records of the camera.
+  const MapIntrinsics& intrinsics() const { return intrinsics_; }
+  // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode).
+  const LoopCloser<Sensor>* loopCloser() const { return loopCloser_.get(); }
+
+ private:
+  const Camera camera_;  // every stage below holds a reference to it
+  std::shared_ptr<const OrbVocabulary> vocabulary_;
+  MapIntrinsics intrinsics_;
+  SlamOptions options_;
+  StageTimer timer_;
+  Map map_;
+  bow::KeyframeDatabase database_;  // relocalisation candidates; fed by local mapping's sink
+  std::unique_ptr<Relocaliser<Sensor>> relocaliser_;
+  std::size_t loadedKeyFrames_ = 0;
+  std::unique_ptr<LocalMapper<Sensor>> mapper_;
+  std::unique_ptr<LoopCloser<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
+  std::unique_ptr<Tracker<Sensor>> tracker_;
+  std::uint64_t frames_ = 0, lost_ = 0;
+  bool shutDown_ = false;
+};
+
+// The map file's record of a camera model: its pinhole, bf (0 without stereo), close-depth
+// threshold, image size and, for a depth sensor, its disparity σ.
+template <CameraModel Camera>
+MapIntrinsics mapIntrinsicsOf(const Camera& camera) {
+  const PinholeCamera<double>& pinhole = pinholeOf(camera);
+  MapIntrinsics k;
+  k.fx = pinhole.fx;
+  k.fy = pinhole.fy;
+  k.cx = pinhole.cx;
+  k.cy = pinhole.cy;
+  if constexpr (StereoCameraModel<Camera>) k.bf = camera.bf();
+  k.closeDepth = camera.closeDepthThreshold();
+  if constexpr (requires { camera.disparitySigma; }) k.disparitySigma = static_cast<double>(camera.disparitySigma);
+  k.maxX = pinhole.width;
+  k.maxY = pinhole.height;
+  return k;
+}
+
+}  // namespace orbis
+
+#include "orbis/system/slam_core_impl.hpp"
+
+namespace orbis {
+extern template class SlamCore<Stereo>;
+extern template class SlamCore<Rgbd>;
+
+}  // namespace orbis

@@ -1,0 +1,166 @@
+// orbis/system/slam_core_impl.hpp — bodies of SlamCore<Sensor> (slam_core.hpp).
+//
+// Contract: included by slam_core.hpp only; see there.
+#pragma once
+
+#include <algorithm>
+
+#include "orbis/io/map_file.hpp"
+#include "orbis/system/slam_core.hpp"
+#include "orbis/util/error.hpp"
+
+namespace orbis {
+
+template <SensorConfiguration Sensor>
+SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options)
+    : camera_(camera), vocabulary_(std::move(vocabulary)), intrinsics_(mapIntrinsicsOf(camera)), options_(options) {
+  LocalMapperOptions mapperOptions;
+  mapperOptions.threaded = !options_.deterministic;
+  mapper_ = std::make_unique<LocalMapper<Sensor>>(camera_, map_, mapperOptions, &timer_);
+  if (options_.loopClosing && !options_.localisationOnly) {
+    LoopCloserOptions loopOptions;
+    loopOptions.threaded = !options_.deterministic;
+    loopOptions.seed = options_.seed;
+    loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);
+  }
+  // Processed keyframes feed the keyframe database: through the loop closer (which queries it
+  // before adding each one) or directly.
+  mapper_->setKeyFrameSink([this](KeyFrame* kf) {
+    if (loopCloser_) loopCloser_->insertKeyFrame(kf);
+    else database_.add(kf->id, kf->bowVector());
+  });
+  // A culled keyframe leaves the database at once (as ORB-SLAM's SetBadFlag does), whether or not
+  // a loop closer runs: relocalisation candidates then count only live keyframes.
+  mapper_->setCulledKeyFrameSink([this](KeyFrame* kf) { database_.erase(kf->id); });
+  TrackerOptions trackerOptions;
+  trackerOptions.maxFramesBetweenKeyFrames = std::max(1, static_cast<int>(options_.fps + 0.5));
+  trackerOptions.localisationOnly = options_.localisationOnly;
+  tracker_ = std::make_unique<Tracker<Sensor>>(map_, *vocabulary_, mapper_.get(), trackerOptions, &timer_);
+  RelocaliserOptions relocaliserOptions;
+  relocaliserOptions.seed = options_.seed;
+  relocaliser_ = std::make_unique<Relocaliser<Sensor>>(map_, database_, relocaliserOptions);
+  // Called by the tracker, map mutex held, when it is lost.
+  tracker_->setRelocaliser([this](Frame<Camera>& frame) { return relocaliser_->relocalise(frame); });
+}
+
+template <SensorConfiguration Sensor>
+SlamCore<Sensor>::~SlamCore() { shutdown(); }
+
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::shutdown() {
+  if (shutDown_) return;
+  shutDown_ = true;
+  if (mapper_) mapper_->waitUntilIdle();
+  if (loopCloser_) {
+    // A loop correction or full BA pauses mapping; mapping must run until they have finished.
+    loopCloser_->waitUntilIdle();
+    mapper_->waitUntilIdle();
+    loopCloser_->shutdown();
+  }
+  if (mapper_) mapper_->shutdown();
+}
+
+template <SensorConfiguration Sensor>
+TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> features, double timestamp) {
+  Frame<Camera> frame;
+  frame.index = frames_++;
+  frame.timestamp = timestamp;
+  frame.camera = &camera_;
+  frame.intrinsics = intrinsics_;
+  // The image bounds keypoints can fall in come from the features (undistorted bounds).
+  frame.intrinsics.minX = features->grid.minX();
+  frame.intrinsics.maxX = features->grid.maxX();
+  frame.intrinsics.minY = features->grid.minY();
+  frame.intrinsics.maxY = features->grid.maxY();
+  frame.features = std::move(features);
+  TrackResult result;
+  {
+    ScopedStage stage(&timer_, "tracking: total");
+    result = tracker_->track(std::move(frame));
+  }
+  if (result.state == TrackingState::Lost) ++lost_;
+  // Deterministic mode: local mapping runs to quiescence after every frame, in order.
+  if (options_.deterministic && result.newKeyFrame) {
+    mapper_->runUntilIdle();
+    if (loopCloser_) loopCloser_->runUntilIdle();
+  }
+  return result;
+}
+
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::setLocalisationOnly(bool on) {
+  std::lock_guard lock(map_.mutex());
+  tracker_->setLocalisationOnly(on);
+}
+
+template <SensorConfiguration Sensor>
+RelocalisationStats SlamCore<Sensor>::relocalisationStats() const {
+  std::lock_guard lock(map_.mutex());
+  return relocaliser_->stats();
+}
+
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::saveMap(const std::filesystem::path& file) {
+  // Queued keyframes would be saved half-processed: let mapping (and loop closing) settle first.
+  if (options_.deterministic) {
+    mapper_->runUntilIdle();
+    if (loopCloser_) loopCloser_->runUntilIdle();
+  } else if (!shutDown_) {
+    mapper_->waitUntilIdle();
+    if (loopCloser_) loopCloser_->waitUntilIdle();
+    mapper_->waitUntilIdle();
+  }
+  std::lock_guard lock(map_.mutex());
+  writeMapFile(file, map_, {sensorKind(), intrinsics_, vocabularyChecksum(*vocabulary_), 0, 0});
+}
+
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::loadMap(const std::filesystem::path& file) {
+  std::lock_guard lock(map_.mutex());
+  if (frames_ != 0) throw fileError(file.string(), "a map can only be loaded before the first frame is tracked");
+  const MapFileInfo info = readMapFile(file, map_, {sensorKind(), intrinsics_, vocabularyChecksum(*vocabulary_), 0, 0});
+  for (KeyFrame* kf : map_.keyFrames()) database_.add(kf->id, kf->bowVector());
+  loadedKeyFrames_ = info.keyFrames;
+  // There is a map already: find the camera in it instead of starting a new one.
+  if (loadedKeyFrames_ > 0) tracker_->startLost();
+}
+
+template <SensorConfiguration Sensor>
+Trajectory SlamCore<Sensor>::trajectory() const {
+  std::lock_guard lock(map_.mutex());
+  Trajectory out;
+  out.reserve(tracker_->trackedFrames().size());
+  for (const TrackedFrame& f : tracker_->trackedFrames()) out.push_back({f.timestamp, worldPoseOf(f).inverse()});
+  return out;
+}
+
+template <SensorConfiguration Sensor>
+Trajectory SlamCore<Sensor>::keyFrameTrajectory() const {
+  std::lock_guard lock(map_.mutex());
+  Trajectory out;
+  for (KeyFrame* kf : map_.keyFrames()) out.push_back({kf->timestamp, kf->Twc()});
+  return out;
+}
+
+template <SensorConfiguration Sensor>
+std::vector<Eigen::Vector3f> SlamCore<Sensor>::mapPointCloud() const {
+  std::lock_guard lock(map_.mutex());
+  std::vector<Eigen::Vector3f> out;
+  for (MapPoint* p : map_.mapPoints()) out.push_back(p->position().cast<float>());
+  return out;
+}
+
+template <SensorConfiguration Sensor>
+SlamStats SlamCore<Sensor>::stats() const {
+  std::lock_guard lock(map_.mutex());
+  SlamStats s;
+  s.frames = frames_;
+  s.tracked = tracker_->trackedFrames().size();
+  s.lost = lost_;
+  s.keyFrames = map_.keyFrameCount();
+  s.mapPoints = map_.mapPointCount();
+  s.loopClosures = loopCloser_ ? loopCloser_->closures().size() : 0;
+  return s;
+}
+
+}  // namespace orbis

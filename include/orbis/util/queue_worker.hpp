@@ -1,0 +1,100 @@
+// orbis/util/queue_worker.hpp — a FIFO of work items and, optionally, the thread that serves it:
+// the scaffolding local mapping and loop closing share.
+//
+// Contract: push() may be called from any thread. In threaded mode start(serve) launches a worker
+// that waits for items (or a wake-up) and calls serve() with busy() set; serve() pops items itself
+// (pop()) and returns when it wants to wait again. Without start() nothing runs on its own: the
+// owner drains the queue on its thread (deterministic mode). waitUntilIdle(drainInline) blocks
+// until the queue is empty and the worker idle, or, with no worker, drains it inline. stop()
+// wakes and joins the worker; items still queued stay queued.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+namespace orbis {
+
+template <class Item>
+class QueueWorker {
+ public:
+  QueueWorker() = default;
+  QueueWorker(const QueueWorker&) = delete;
+  QueueWorker& operator=(const QueueWorker&) = delete;
+  ~QueueWorker() { stop(); }
+
+  void start(std::function<void()> serve) {
+    thread_ = std::thread([this, serve = std::move(serve)] {
+      while (!finishing()) {
+        {
+          std::unique_lock lock(mutex_);
+          // A bounded wait: serve() may have returned with items left (mapping paused), and
+          // flags it polls change without a notification.
+          cv_.wait_for(lock, std::chrono::milliseconds(5), [this] { return finish_.load() || !queue_.empty(); });
+        }
+        if (finishing()) break;
+        busy_ = true;
+        serve();
+        busy_ = false;
+      }
+    });
+  }
+
+  void push(Item item) {
+    {
+      std::lock_guard lock(mutex_);
+      queue_.push_back(std::move(item));
+    }
+    cv_.notify_all();
+  }
+  std::optional<Item> pop() {
+    std::lock_guard lock(mutex_);
+    if (queue_.empty()) return std::nullopt;
+    Item item = std::move(queue_.front());
+    queue_.pop_front();
+    return item;
+  }
+  std::size_t size() const {
+    std::lock_guard lock(mutex_);
+    return queue_.size();
+  }
+  // Wakes the worker to look at its flags again.
+  void wake() { cv_.notify_all(); }
+
+  bool threaded() const { return thread_.joinable(); }
+  bool busy() const { return busy_.load(); }
+  bool finishing() const { return finish_.load(); }
+
+  // `alsoIdle` adds the owner's own condition (for instance no full BA running).
+  void waitUntilIdle(const std::function<void()>& drainInline, const std::function<bool()>& alsoIdle = {}) {
+    while (true) {
+      if (size() == 0 && !busy() && (!alsoIdle || alsoIdle())) return;
+      if (!threaded()) {
+        drainInline();
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+
+  void stop() {
+    finish_ = true;
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Item> queue_;
+  std::atomic<bool> busy_{false};
+  std::atomic<bool> finish_{false};
+  std::thread thread_;
+};
+
+}  // namespace orbis
