@@ -165,3 +165,9 @@ class Vocabulary {
 using OrbVocabulary = Vocabulary<OrbDescriptor, HammingDistance>;
 
 }  // namespace orbis::bow
+
+namespace orbis {
+// The pipeline's vocabulary, named where the system, its map files and its users need it
+// without reaching into the threads that use it.
+using OrbVocabulary = bow::OrbVocabulary;
+}  // namespace orbis
