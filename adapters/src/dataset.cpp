@@ -27,25 +27,6 @@ std::string_view toString(DatasetKind kind) {
   return "?";
 }
 
-SensorKind parseSensorKind(std::string_view name, const std::string& source) {
-  if (name == "mono" || name == "monocular") return SensorKind::Monocular;
-  if (name == "stereo") return SensorKind::Stereo;
-  if (name == "rgbd") return SensorKind::Rgbd;
-  throw Error(source, "", "unknown sensor '" + std::string(name) + "' (expected mono, stereo or rgbd)");
-}
-
-std::string_view toString(SensorKind sensor) {
-  switch (sensor) {
-    case SensorKind::Monocular:
-      return "mono";
-    case SensorKind::Stereo:
-      return "stereo";
-    case SensorKind::Rgbd:
-      return "rgbd";
-  }
-  return "?";
-}
-
 std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root) {
   namespace fs = std::filesystem;
   if (fs::exists(root / "rgb.txt")) return DatasetKind::TumRgbd;

@@ -37,11 +37,6 @@ concept BinaryDescriptor =
       { d.bytes() } -> std::same_as<std::uint8_t*>;
     };
 
-template <class P, class D>
-concept DescriptorDistance = std::default_initializable<P> && requires(const P p, const D& a) {
-  { p(a, a) } -> std::convertible_to<int>;
-};
-
 template <BinaryDescriptor Descriptor, DescriptorDistance<Descriptor> Distance>
 class Vocabulary {
  public:
