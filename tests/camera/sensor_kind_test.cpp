@@ -37,8 +37,9 @@ TEST(SensorKindNames, UnknownNameIsAnErrorNamingItsOrigin) {
       EXPECT_EQ(e.source(), "settings.yaml");
       EXPECT_EQ(e.where(), "key Sensor");
       const std::string message = e.what();
-      EXPECT_NE(message.find("expected mono, monocular, stereo, rgbd or rgb-d"), std::string::npos) << message;
-      EXPECT_NE(message.find("found \"" + std::string(name) + "\""), std::string::npos) << message;
+      EXPECT_NE(message.find("unknown sensor \"" + std::string(name) + "\""), std::string::npos) << message;
+      EXPECT_NE(message.find("(expected mono, monocular, stereo, rgbd or rgb-d; any letter case)"), std::string::npos)
+          << message;
     }
   }
 }
