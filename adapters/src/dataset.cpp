@@ -4,47 +4,21 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "dataset_common.hpp"
+#include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis {
 
+namespace {
+constexpr EnumName<DatasetKind> kDatasetKindNames[] = {
+    {DatasetKind::TumRgbd, "tum"}, {DatasetKind::Euroc, "euroc"}, {DatasetKind::Kitti, "kitti"}};
+}  // namespace
+
 DatasetKind parseDatasetKind(std::string_view name, const std::string& source) {
-  if (name == "tum") return DatasetKind::TumRgbd;
-  if (name == "euroc") return DatasetKind::Euroc;
-  if (name == "kitti") return DatasetKind::Kitti;
-  throw Error(source, "", "unknown dataset kind '" + std::string(name) + "' (expected tum, euroc or kitti)");
+  return parseEnumName(kDatasetKindNames, name, "dataset kind", source);
 }
 
-std::string_view toString(DatasetKind kind) {
-  switch (kind) {
-    case DatasetKind::TumRgbd:
-      return "tum";
-    case DatasetKind::Euroc:
-      return "euroc";
-    case DatasetKind::Kitti:
-      return "kitti";
-  }
-  return "?";
-}
-
-SensorKind parseSensorKind(std::string_view name, const std::string& source) {
-  if (name == "mono" || name == "monocular") return SensorKind::Monocular;
-  if (name == "stereo") return SensorKind::Stereo;
-  if (name == "rgbd") return SensorKind::Rgbd;
-  throw Error(source, "", "unknown sensor '" + std::string(name) + "' (expected mono, stereo or rgbd)");
-}
-
-std::string_view toString(SensorKind sensor) {
-  switch (sensor) {
-    case SensorKind::Monocular:
-      return "mono";
-    case SensorKind::Stereo:
-      return "stereo";
-    case SensorKind::Rgbd:
-      return "rgbd";
-  }
-  return "?";
-}
+std::string_view toString(DatasetKind kind) { return enumName(kDatasetKindNames, kind); }
 
 std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root) {
   namespace fs = std::filesystem;

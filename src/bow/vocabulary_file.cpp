@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "orbis/util/atomic_file.hpp"
+#include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis::bow {
@@ -114,21 +115,14 @@ std::uint64_t checksum64(const void* data, std::size_t size, std::uint64_t seed)
   return h;
 }
 
-std::string_view weightingName(Weighting w) {
-  switch (w) {
-    case Weighting::TfIdf: return "tf-idf";
-    case Weighting::Tf: return "tf";
-    case Weighting::Idf: return "idf";
-    case Weighting::Binary: return "binary";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<Weighting> kWeightingNames[] = {
+    {Weighting::TfIdf, "tf-idf"}, {Weighting::Tf, "tf"}, {Weighting::Idf, "idf"}, {Weighting::Binary, "binary"}};
+}  // namespace
 
-std::optional<Weighting> parseWeighting(std::string_view name) {
-  for (Weighting w : {Weighting::TfIdf, Weighting::Tf, Weighting::Idf, Weighting::Binary})
-    if (weightingName(w) == name) return w;
-  return std::nullopt;
-}
+std::string_view weightingName(Weighting w) { return enumName(kWeightingNames, w); }
+
+std::optional<Weighting> parseWeighting(std::string_view name) { return findEnumName(kWeightingNames, name); }
 
 void VocabularyBlob::adopt(std::shared_ptr<const std::byte> data, std::size_t size, const std::string& source) {
   const auto fail = [&](const std::string& what) { return fileError(source, what); };

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis::eval {
@@ -31,24 +32,16 @@ std::vector<PosePair> associateByIndex(const Trajectory& groundTruth, const Traj
   return pairs;
 }
 
+namespace {
+constexpr EnumName<Alignment> kAlignmentNames[] = {
+    {Alignment::SE3, "se3"}, {Alignment::Sim3, "sim3"}, {Alignment::None, "none"}};
+}  // namespace
+
 Alignment parseAlignment(std::string_view name, const std::string& source) {
-  if (name == "none") return Alignment::None;
-  if (name == "se3") return Alignment::SE3;
-  if (name == "sim3") return Alignment::Sim3;
-  throw Error(source, "", "unknown alignment '" + std::string(name) + "' (expected se3, sim3 or none)");
+  return parseEnumName(kAlignmentNames, name, "alignment", source);
 }
 
-std::string_view toString(Alignment alignment) {
-  switch (alignment) {
-    case Alignment::None:
-      return "none";
-    case Alignment::SE3:
-      return "se3";
-    case Alignment::Sim3:
-      return "sim3";
-  }
-  return "?";
-}
+std::string_view toString(Alignment alignment) { return enumName(kAlignmentNames, alignment); }
 
 Sim3d umeyamaAlignment(const Eigen::Matrix3Xd& source, const Eigen::Matrix3Xd& target, bool estimateScale) {
   const Eigen::Index n = source.cols();

@@ -22,15 +22,6 @@ constexpr char kMagic[8] = {'O', 'R', 'B', 'I', 'S', 'M', 'A', 'P'};
 constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 + 8 + 10 * 8 + 8 + 8;
 constexpr std::size_t kTrailerBytes = 8;
 
-const char* sensorName(std::uint32_t s) {
-  switch (s) {
-    case static_cast<std::uint32_t>(SensorKind::Monocular): return "monocular";
-    case static_cast<std::uint32_t>(SensorKind::Stereo): return "stereo";
-    case static_cast<std::uint32_t>(SensorKind::Rgbd): return "RGB-D";
-  }
-  return "unknown";
-}
-
 // Plain records for the arrays (std::pair is not trivially copyable); none has padding.
 struct NodeFeature {
   bow::NodeId node;
@@ -300,8 +291,8 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
   info.keyFrames = header.get<std::uint64_t>("keyframe count");
   info.mapPoints = header.get<std::uint64_t>("map point count");
   if (info.sensor != expected.sensor)
-    throw fileError(file, std::string("map made with sensor ") + sensorName(sensor) + ", this system's sensor is " +
-                              sensorName(static_cast<std::uint32_t>(expected.sensor)));
+    throw fileError(file, "map made with sensor " + std::string(toString(info.sensor)) + ", this system's sensor is " +
+                              std::string(toString(expected.sensor)));
   if (info.vocabularyChecksum != expected.vocabularyChecksum)
     throw fileError(file, "map made with another vocabulary (checksum " + std::to_string(info.vocabularyChecksum) +
                               ", this system's vocabulary has " + std::to_string(expected.vocabularyChecksum) + ")");

@@ -1,9 +1,6 @@
 // ORB-SLAM2 settings reader; see orbis/io/settings.hpp.
 #include "orbis/io/settings.hpp"
 
-#include <algorithm>
-#include <cctype>
-
 #include "../camera/yaml_reader.hpp"
 
 namespace orbis {
@@ -12,19 +9,10 @@ namespace {
 
 using detail::YamlReader;
 
-std::optional<SensorKind> parseSensor(std::string name) {
-  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (name == "mono" || name == "monocular") return SensorKind::Monocular;
-  if (name == "stereo") return SensorKind::Stereo;
-  if (name == "rgbd" || name == "rgb-d") return SensorKind::Rgbd;
-  return std::nullopt;
-}
-
 SensorKind chooseSensor(const YamlReader& yaml, std::optional<SensorKind> requested) {
   if (requested) return *requested;
   if (const auto name = yaml.optionalString("Sensor")) {
-    if (const auto kind = parseSensor(*name)) return *kind;
-    throw yaml.error("Sensor", "expected mono, stereo or rgbd, found \"" + *name + "\"");
+    return parseSensorKind(*name, yaml.path(), "key Sensor");
   }
   if (!yaml.has("Camera.bf")) return SensorKind::Monocular;
   return yaml.has("DepthMapFactor") ? SensorKind::Rgbd : SensorKind::Stereo;
@@ -141,15 +129,6 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
 }
 
 }  // namespace
-
-std::string_view sensorName(SensorKind sensor) {
-  switch (sensor) {
-    case SensorKind::Monocular: return "mono";
-    case SensorKind::Stereo: return "stereo";
-    case SensorKind::Rgbd: return "rgbd";
-  }
-  return "unknown";
-}
 
 Settings Settings::load(const std::filesystem::path& file) { return loadSettings(file, std::nullopt); }
 

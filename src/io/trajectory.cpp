@@ -9,6 +9,7 @@
 #include <memory>
 #include <tuple>
 
+#include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis {
@@ -98,22 +99,16 @@ long long parseInteger(std::string_view field, const std::filesystem::path& file
   return value;
 }
 
+namespace {
+constexpr EnumName<TrajectoryFormat> kTrajectoryFormatNames[] = {
+    {TrajectoryFormat::Tum, "tum"}, {TrajectoryFormat::Kitti, "kitti"}, {TrajectoryFormat::Euroc, "euroc"}};
+}  // namespace
+
 TrajectoryFormat parseTrajectoryFormat(std::string_view name, const std::string& source) {
-  if (name == "tum") return TrajectoryFormat::Tum;
-  if (name == "kitti") return TrajectoryFormat::Kitti;
-  if (name == "euroc") return TrajectoryFormat::Euroc;
-  throw Error(source, "", "unknown trajectory format '" + std::string(name) +
-                              "' (expected tum, kitti or euroc)");
+  return parseEnumName(kTrajectoryFormatNames, name, "trajectory format", source);
 }
 
-std::string_view toString(TrajectoryFormat format) {
-  switch (format) {
-    case TrajectoryFormat::Tum: return "tum";
-    case TrajectoryFormat::Kitti: return "kitti";
-    case TrajectoryFormat::Euroc: return "euroc";
-  }
-  return "?";
-}
+std::string_view toString(TrajectoryFormat format) { return enumName(kTrajectoryFormatNames, format); }
 
 TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& file) {
   if (file.extension() == ".csv") return TrajectoryFormat::Euroc;

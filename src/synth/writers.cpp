@@ -11,6 +11,7 @@
 
 #include "orbis/features/orb_params.hpp"
 #include "orbis/io/trajectory.hpp"
+#include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis::synth {
@@ -119,21 +120,16 @@ void writeKittiCalib(const fs::path& file, const SyntheticSequence& seq) {
 
 }  // namespace
 
+namespace {
+constexpr EnumName<SynthLayout> kSynthLayoutNames[] = {
+    {SynthLayout::Tum, "tum"}, {SynthLayout::Euroc, "euroc"}, {SynthLayout::Kitti, "kitti"}};
+}  // namespace
+
 SynthLayout parseSynthLayout(std::string_view name, const std::string& source) {
-  if (name == "tum") return SynthLayout::Tum;
-  if (name == "euroc") return SynthLayout::Euroc;
-  if (name == "kitti") return SynthLayout::Kitti;
-  throw Error(source, "", "expected tum, euroc or kitti, got '" + std::string(name) + "'");
+  return parseEnumName(kSynthLayoutNames, name, "layout", source);
 }
 
-std::string_view toString(SynthLayout layout) {
-  switch (layout) {
-    case SynthLayout::Tum: return "tum";
-    case SynthLayout::Euroc: return "euroc";
-    case SynthLayout::Kitti: return "kitti";
-  }
-  return "?";
-}
+std::string_view toString(SynthLayout layout) { return enumName(kSynthLayoutNames, layout); }
 
 void writeSynthSettings(const fs::path& file, const SyntheticSequence& seq, std::string_view sensor) {
   const SynthOptions& o = seq.options();

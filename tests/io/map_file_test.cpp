@@ -241,7 +241,7 @@ TEST(MapFile, OtherVocabularySensorOrCameraIsAnError) {
   expectLoadError(file, otherVocabulary, "another vocabulary");
   MapFileInfo otherSensor = expectation();
   otherSensor.sensor = SensorKind::Stereo;
-  expectLoadError(file, otherSensor, "map made with sensor RGB-D, this system's sensor is stereo");
+  expectLoadError(file, otherSensor, "map made with sensor rgbd, this system's sensor is stereo");
   MapFileInfo otherCamera = expectation();
   otherCamera.intrinsics.fx = 520;
   expectLoadError(file, otherCamera, "key fx");

@@ -37,11 +37,6 @@ concept BinaryDescriptor =
       { d.bytes() } -> std::same_as<std::uint8_t*>;
     };
 
-template <class P, class D>
-concept DescriptorDistance = std::default_initializable<P> && requires(const P p, const D& a) {
-  { p(a, a) } -> std::convertible_to<int>;
-};
-
 template <BinaryDescriptor Descriptor, DescriptorDistance<Descriptor> Distance>
 class Vocabulary {
  public:
@@ -167,6 +162,7 @@ using OrbVocabulary = Vocabulary<OrbDescriptor, HammingDistance>;
 }  // namespace orbis::bow
 
 namespace orbis {
-// The vocabulary of the SLAM pipeline, the map file and the keyframe database.
-using bow::OrbVocabulary;
+// The pipeline's vocabulary, named where the system, its map files and its users need it
+// without reaching into the threads that use it.
+using OrbVocabulary = bow::OrbVocabulary;
 }  // namespace orbis

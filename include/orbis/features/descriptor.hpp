@@ -1,12 +1,13 @@
 // orbis/features/descriptor.hpp — the 256-bit binary ORB descriptor and its Hamming distance.
 //
 // Contract: OrbDescriptor is 32 bytes stored as four 64-bit words (trivially copyable, 8-byte
-// aligned); hammingDistance uses the hardware popcount when the compiler enables it. The
-// distance policy HammingDistance is what the matchers and the vocabulary are templated on.
+// aligned); hammingDistance uses the hardware popcount when the compiler enables it.
+// DescriptorDistance is the one concept of a distance policy; HammingDistance is ORB's.
 #pragma once
 
 #include <array>
 #include <bit>
+#include <concepts>
 #include <cstdint>
 #include <cstring>
 
@@ -39,12 +40,21 @@ inline int hammingDistance(const OrbDescriptor& a, const OrbDescriptor& b) {
          std::popcount(a.words[2] ^ b.words[2]) + std::popcount(a.words[3] ^ b.words[3]);
 }
 
-// Distance policy for templates over descriptor types (matchers, vocabulary).
+// A distance policy between descriptors of type D, what the matchers and the vocabulary are
+// templated on: default-constructible (both take it by value, defaulted to {}) and giving an
+// integer distance, smaller meaning more alike.
+template <class P, class D>
+concept DescriptorDistance = std::default_initializable<P> && requires(const P p, const D& a) {
+  { p(a, a) } -> std::convertible_to<int>;
+};
+
+// The distance policy of binary descriptors.
 struct HammingDistance {
   using Descriptor = OrbDescriptor;
   using Distance = int;
   static constexpr int kMax = OrbDescriptor::kBits;
   int operator()(const OrbDescriptor& a, const OrbDescriptor& b) const { return hammingDistance(a, b); }
 };
+static_assert(DescriptorDistance<HammingDistance, OrbDescriptor>);
 
 }  // namespace orbis

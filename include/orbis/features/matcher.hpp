@@ -50,11 +50,6 @@ inline constexpr float kRatioStrict = 0.75f;
 inline constexpr double kEpipolarChi2 = 3.84;
 }  // namespace matching
 
-template <class D>
-concept DescriptorDistance = requires(const D& d, const typename D::Descriptor& a) {
-  { d(a, a) } -> std::convertible_to<int>;
-};
-
 struct ProjectionQuery {
   float u = 0, v = 0;    // predicted undistorted pixel
   float uRight = -1.f;   // predicted right coordinate; < 0 for none
@@ -124,7 +119,7 @@ long bestEpipolarPartner(const FrameFeatures& f1, std::size_t i1, const FrameFea
 // matches[q] = keypoint index or -1; `taken` marks keypoints already matched (may be empty).
 // Returns the number of matches.
 template <class Distance = HammingDistance>
-  requires DescriptorDistance<Distance>
+  requires DescriptorDistance<Distance, OrbDescriptor>
 int searchByProjection(const FrameFeatures& frame, std::span<const ProjectionQuery> queries, float th,
                        float ratio, std::span<const std::uint8_t> taken, std::vector<int>& matches,
                        const Distance& distance = {}) {
@@ -168,7 +163,7 @@ int searchByProjection(const FrameFeatures& frame, std::span<const ProjectionQue
 // forward/backward: the camera advanced/retreated along its axis by more than the baseline
 // (stereo/RGB-D only; pass false for monocular). matches[q] = keypoint index or -1.
 template <class Distance = HammingDistance>
-  requires DescriptorDistance<Distance>
+  requires DescriptorDistance<Distance, OrbDescriptor>
 int searchFrameToFrame(const FrameFeatures& current, std::span<const TrackedQuery> queries, float th,
                        bool forward, bool backward, bool checkOrientation,
                        std::span<const std::uint8_t> taken, std::vector<int>& matches,
@@ -223,7 +218,7 @@ int searchFrameToFrame(const FrameFeatures& current, std::span<const TrackedQuer
 // predictedInFrame2[i]: where keypoint i of frame 1 is expected in frame 2 (its previous
 // match, or its own position). matches12[i] = keypoint of frame 2 or -1.
 template <class Distance = HammingDistance>
-  requires DescriptorDistance<Distance>
+  requires DescriptorDistance<Distance, OrbDescriptor>
 int searchForInitialization(const FrameFeatures& f1, const FrameFeatures& f2,
                             std::span<const Eigen::Vector2f> predictedInFrame2, float windowSize, float ratio,
                             bool checkOrientation, std::vector<int>& matches12, const Distance& distance = {}) {
@@ -286,7 +281,7 @@ struct EpipolarSearchOptions {
 
 // Pairs (i1, i2) of keypoints consistent with F21; epipole2 is camera 1's centre in image 2.
 template <class Distance = HammingDistance>
-  requires DescriptorDistance<Distance>
+  requires DescriptorDistance<Distance, OrbDescriptor>
 int searchForTriangulation(const FrameFeatures& f1, const FrameFeatures& f2, const Eigen::Matrix3d& F21d,
                            const Eigen::Vector2f& epipole2, const EpipolarSearchOptions& options,
                            std::vector<std::pair<int, int>>& pairs, const Distance& distance = {}) {
@@ -327,7 +322,7 @@ int searchForTriangulation(const FrameFeatures& f1, const FrameFeatures& f2, con
 // Exhaustive nearest neighbour of each query among `train`, at most maxDistance; with
 // crossCheck, kept only when the query is also the train descriptor's nearest neighbour.
 template <class Distance = HammingDistance>
-  requires DescriptorDistance<Distance>
+  requires DescriptorDistance<Distance, typename Distance::Descriptor>
 std::vector<DescriptorMatch> bruteForceMatch(std::span<const typename Distance::Descriptor> query,
                                              std::span<const typename Distance::Descriptor> train,
                                              int maxDistance = matching::kThHigh, bool crossCheck = true,

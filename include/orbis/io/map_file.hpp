@@ -21,9 +21,9 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "orbis/bow/vocabulary.hpp"
 #include "orbis/camera/sensor_kind.hpp"
 #include "orbis/map/map.hpp"
-#include "orbis/bow/vocabulary.hpp"
 
 namespace orbis {
 

@@ -3,12 +3,12 @@
 // Contract: Settings::load() reads an ORB-SLAM2 settings file unchanged (it starts with
 // %YAML:1.0): Camera.fx/fy/cx/cy/k1/k2/p1/p2[/k3/width/height/fps/RGB/bf], ThDepth,
 // DepthMapFactor, ORBextractor.*, and the optional LEFT./RIGHT. rectification blocks
-// (K, D, R, P, width, height) of its EuRoC file. orbis adds two optional keys: Sensor
-// (mono | stereo | rgbd) and System.seed. The sensor is chosen once here, in this order: the
-// argument of load(), the Sensor key, else inferred as ORB-SLAM2's files imply (no Camera.bf:
-// mono; Camera.bf and DepthMapFactor: rgbd; Camera.bf only: stereo). The camera is then one
-// alternative of a std::variant; code past this boundary dispatches once with std::visit and
-// runs on the concrete, compile-time camera type.
+// (K, D, R, P, width, height) of its EuRoC file. orbis adds two optional keys: Sensor (mono |
+// stereo | rgbd, read by parseSensorKind) and System.seed. The sensor is chosen once here, in
+// this order: the argument of load(), the Sensor key, else inferred as ORB-SLAM2's files imply
+// (no Camera.bf: mono; Camera.bf and DepthMapFactor: rgbd; Camera.bf only: stereo). The camera
+// is then one alternative of a std::variant; code past this boundary dispatches once with
+// std::visit and runs on the concrete, compile-time camera type.
 // Every missing or malformed key (wrong type, non-positive focal length, ...) throws
 // orbis::Error naming the file and the key; an unreadable file names the file (and the line).
 #pragma once
@@ -28,9 +28,8 @@
 
 namespace orbis {
 
-// SensorKind: orbis/camera/sensor_kind.hpp (shared with the dataset readers).
-
-std::string_view sensorName(SensorKind sensor);  // "mono", "stereo", "rgbd"
+// SensorKind, its names and their parser: orbis/camera/sensor_kind.hpp (shared with the dataset
+// readers and the command line).
 
 using CameraVariant = std::variant<PinholeCamera<double>, RectifiedStereoCamera<double>, RgbdCamera<double>>;
 

@@ -1,7 +1,7 @@
 // orbis/optim/bal.hpp — BAL's 9-parameter camera as a user-defined residual, solved by the same
 // engine as the SLAM problems, and the export of a SLAM reprojection problem to BAL for replay.
 //
-// Contract: BalReprojection implements BAL's model (see orbis/io/bal.hpp) with analytic
+// Contract: BalReprojection implements BAL's model (see orbis/optim/bal_problem.hpp) with analytic
 // Jacobians; the camera block is Euclidean (δ added to angle-axis, translation, f, k1, k2, as
 // Ceres' BAL example does). solveBal() builds the problem with Huber loss δ on the pixel
 // residuals, solves it in place and reports costs in Ceres' convention. exportBal() turns a
@@ -12,7 +12,7 @@
 #pragma once
 
 #include "orbis/geometry/so3.hpp"
-#include "orbis/io/bal.hpp"
+#include "orbis/optim/bal_problem.hpp"
 #include "orbis/optim/manifold.hpp"
 #include "orbis/optim/problem.hpp"
 #include "orbis/optim/reprojection.hpp"

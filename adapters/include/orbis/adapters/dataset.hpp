@@ -30,13 +30,12 @@
 namespace orbis {
 
 enum class DatasetKind { TumRgbd, Euroc, Kitti };
-// SensorKind: orbis/camera/sensor_kind.hpp (shared with the dataset readers).
+// SensorKind, parseSensorKind and toString(SensorKind): orbis/camera/sensor_kind.hpp (shared with
+// the settings reader).
 
 // "tum", "euroc", "kitti"; throws orbis::Error(source) otherwise.
 DatasetKind parseDatasetKind(std::string_view name, const std::string& source = "dataset kind");
 std::string_view toString(DatasetKind kind);
-SensorKind parseSensorKind(std::string_view name, const std::string& source = "sensor");
-std::string_view toString(SensorKind sensor);
 // Recognises a dataset folder by its files (rgb.txt; mav0/; sequences/ or times.txt).
 std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root);
 
