@@ -149,12 +149,23 @@ class TrackingState(enum.Enum):
 TrackResult = Tuple[TrackingState, Optional[npt.NDArray[np.float64]]]
 
 class _Slam:
+    """Stub-only base: what StereoSlam and RgbdSlam share."""
+
+    @overload
+    def __init__(self, settings: Settings, vocabulary: Optional[Vocabulary] = None, *, deterministic: bool = False,
+                 localisation_only: bool = False, loop_closing: bool = True, seed: int = 0,
+                 fps: Optional[float] = None) -> None: ...
+    @overload
+    def __init__(self, dataset: Dataset, vocabulary: Optional[Vocabulary] = None, *, deterministic: bool = False,
+                 localisation_only: bool = False, loop_closing: bool = True, seed: int = 0,
+                 fps: Optional[float] = None) -> None: ...
     def trajectory(self) -> npt.NDArray[np.float64]: ...
     def keyframe_trajectory(self) -> npt.NDArray[np.float64]: ...
     def save_trajectory(self, path: PathLike, format: str = "tum", keyframes: bool = False) -> None: ...
     def map_points(self) -> npt.NDArray[np.float32]: ...
     def stats(self) -> Dict[str, int]: ...
     def timing(self) -> List[Dict[str, Any]]: ...
+    def track_times(self) -> npt.NDArray[np.float64]: ...
     @property
     def state(self) -> TrackingState: ...
     @property
@@ -167,28 +178,12 @@ class _Slam:
 
 class StereoSlam(_Slam):
     @overload
-    def __init__(self, settings: Settings, vocabulary: Optional[Vocabulary] = None, *, deterministic: bool = False,
-                 localisation_only: bool = False, loop_closing: bool = True, seed: int = 0,
-                 fps: Optional[float] = None) -> None: ...
-    @overload
-    def __init__(self, dataset: Dataset, vocabulary: Optional[Vocabulary] = None, *, deterministic: bool = False,
-                 localisation_only: bool = False, loop_closing: bool = True, seed: int = 0,
-                 fps: Optional[float] = None) -> None: ...
-    @overload
     def track(self, left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8], timestamp: float) -> TrackResult: ...
     @overload
     def track(self, frame: Frame) -> TrackResult: ...
     def __enter__(self) -> StereoSlam: ...
 
 class RgbdSlam(_Slam):
-    @overload
-    def __init__(self, settings: Settings, vocabulary: Optional[Vocabulary] = None, *, deterministic: bool = False,
-                 localisation_only: bool = False, loop_closing: bool = True, seed: int = 0,
-                 fps: Optional[float] = None) -> None: ...
-    @overload
-    def __init__(self, dataset: Dataset, vocabulary: Optional[Vocabulary] = None, *, deterministic: bool = False,
-                 localisation_only: bool = False, loop_closing: bool = True, seed: int = 0,
-                 fps: Optional[float] = None) -> None: ...
     @overload
     def track(self, image: npt.NDArray[np.uint8], depth: Union[npt.NDArray[np.uint16], npt.NDArray[np.float32]],
               timestamp: float) -> TrackResult: ...
@@ -198,7 +193,9 @@ class RgbdSlam(_Slam):
 
 # ---- evaluation -------------------------------------------------------------------------------
 
-class AteResult:
+class _ErrorStatistics:
+    """Stub-only base: the statistics of an error (ATE: metres; RPE: translation, metres)."""
+
     rmse: float
     mean: float
     median: float
@@ -206,19 +203,14 @@ class AteResult:
     min: float
     std: float
     count: int
+
+class AteResult(_ErrorStatistics):
     scale: float
     alignment: npt.NDArray[np.float64]
     errors: npt.NDArray[np.float64]
     aligned_estimate: npt.NDArray[np.float64]
 
-class RpeResult:
-    rmse: float
-    mean: float
-    median: float
-    max: float
-    min: float
-    std: float
-    count: int
+class RpeResult(_ErrorStatistics):
     rotation_deg: Dict[str, float]
     matched: int
     times: npt.NDArray[np.float64]

@@ -78,6 +78,9 @@ void bindQueries(py::class_<SlamSession<Sensor>>& c) {
           "The map's points: (N, 3) float32 world coordinates, metres.")
       .def("timing", [](Session& s) { return timingList(s.locked([](S& slam) { return slam.timer().summary(); })); },
            "Per-stage timing: a list of dicts stage, count, mean_ms, median_ms, p95_ms, max_ms.")
+      .def("track_times", [](Session& s) { return vectorToArray(s.trackTimes()); },
+           "Wall time in ms of each track() call's C++ part (ORB extraction and tracking, plus mapping\n"
+           "inline in deterministic mode); a call's time seen from Python minus this is the binding's.")
       .def_property_readonly("state", [](Session& s) { return s.locked([](S& slam) { return slam.state(); }); })
       .def_property_readonly("camera", [](const Session& s) { return describeCamera(s.camera()); });
   c.def(

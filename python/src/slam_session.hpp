@@ -3,18 +3,20 @@
 //
 // Contract: track() is called with the GIL held, checks the input against the camera, then
 // releases the GIL, locks the session and tracks; locked(fn) runs any other query or command the
-// same way. The destructor joins the mapping threads without the GIL. Input errors raise
+// same way, and keeps each call's C++ time (trackTimes). The destructor joins the mapping threads without the GIL. Input errors raise
 // ValueError (size, timestamp); tracking after shutdown() raises orbis.Error.
 #pragma once
 
 #include <pybind11/pybind11.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "arrays.hpp"
 #include "orbis/system/slam.hpp"
@@ -56,7 +58,9 @@ class SlamSession {
         throw py::value_error("timestamp " + std::to_string(input.timestamp) + " does not increase (last " +
                               std::to_string(lastTimestamp_) + ")");
       lastTimestamp_ = input.timestamp;
+      const auto start = std::chrono::steady_clock::now();
       result = slam_->track(input);
+      trackMs_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     }
     py::object pose = py::none();
     if (result.state == TrackingState::Ok) pose = poseToArray(result.Tcw.inverse());
@@ -80,6 +84,11 @@ class SlamSession {
     localisationOnly_ = on;
   }
   bool localisationOnly() const { return localisationOnly_; }
+  // Wall time of each track() call's C++ part (Slam::track), ms: the binding's cost is a call's
+  // time seen from Python minus this.
+  std::vector<double> trackTimes() {
+    return locked([this](Slam<Sensor>&) { return trackMs_; });
+  }
   const Camera& camera() const { return camera_; }
 
  private:
@@ -101,6 +110,7 @@ class SlamSession {
   std::mutex mutex_;
   double lastTimestamp_ = -std::numeric_limits<double>::infinity();
   bool shutDown_ = false;
+  std::vector<double> trackMs_;
 };
 
 }  // namespace orbis::python
