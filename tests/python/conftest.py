@@ -48,3 +48,11 @@ def cli_run(cli: Path, synthetic: Path, tmp_path_factory: pytest.TempPathFactory
     run_cli(cli, "run", "tum", synthetic, "--settings", synthetic / "settings.yaml", "--deterministic",
             "--out", out, "--save-map", out / "room.map")
     return out
+
+
+@pytest.fixture(scope="session")
+def synthetic_stereo(cli: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A rendered 40-frame rectified stereo sequence in the KITTI layout (640 x 480)."""
+    folder = tmp_path_factory.mktemp("synthetic_stereo") / "room"
+    run_cli(cli, "synth", folder, "--layout", "kitti", "--frames", 40, "--seed", 3)
+    return folder
