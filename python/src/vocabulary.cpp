@@ -74,6 +74,29 @@ std::shared_ptr<OrbVocabulary> train(const py::iterable& images, std::uint32_t k
   return std::make_shared<OrbVocabulary>(bow::trainVocabulary<OrbDescriptor, HammingDistance>(documents, params));
 }
 
+py::array_t<std::uint32_t> wordsOf(const OrbVocabulary& v, const py::handle& descriptors) {
+  const std::vector<OrbDescriptor> d = descriptorsFrom(descriptors, "descriptors");
+  py::array_t<std::uint32_t> out(static_cast<py::ssize_t>(d.size()));
+  std::uint32_t* word = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for (const OrbDescriptor& one : d) *word++ = v.wordOf(one);
+  }
+  return out;
+}
+
+py::dict bowVectorOf(const OrbVocabulary& v, const py::handle& descriptors) {
+  const std::vector<OrbDescriptor> d = descriptorsFrom(descriptors, "descriptors");
+  bow::BowVector bow;
+  {
+    py::gil_scoped_release release;
+    bow = v.transform(d);
+  }
+  py::dict out;
+  for (const auto& entry : bow) out[py::int_(entry.word)] = entry.weight;
+  return out;
+}
+
 py::tuple extractOrb(const py::handle& image, const OrbParams& params) {
   const ImageView view = imageView(image, "image");
   std::vector<Keypoint> keypoints;
@@ -123,33 +146,9 @@ void bindVocabulary(py::module_& m) {
       .def_property_readonly("word_count", &OrbVocabulary::wordCount)
       .def_property_readonly("node_count", &OrbVocabulary::nodeCount)
       .def_property_readonly("weighting", [](const OrbVocabulary& v) { return std::string(bow::weightingName(v.weighting())); })
-      .def(
-          "words",
-          [](const OrbVocabulary& v, const py::handle& descriptors) {
-            const std::vector<OrbDescriptor> d = descriptorsFrom(descriptors, "descriptors");
-            py::array_t<std::uint32_t> out(static_cast<py::ssize_t>(d.size()));
-            std::uint32_t* word = out.mutable_data();
-            {
-              py::gil_scoped_release release;
-              for (const OrbDescriptor& one : d) *word++ = v.wordOf(one);
-            }
-            return out;
-          },
-          "descriptors"_a, "The word id of each descriptor row (uint32 array).")
-      .def(
-          "transform",
-          [](const OrbVocabulary& v, const py::handle& descriptors) {
-            const std::vector<OrbDescriptor> d = descriptorsFrom(descriptors, "descriptors");
-            bow::BowVector bow;
-            {
-              py::gil_scoped_release release;
-              bow = v.transform(d);
-            }
-            py::dict out;
-            for (const auto& entry : bow) out[py::int_(entry.word)] = entry.weight;
-            return out;
-          },
-          "descriptors"_a, "The L1-normalised bag-of-words vector {word id: weight} of a set of descriptors.")
+      .def("words", &wordsOf, "descriptors"_a, "The word id of each descriptor row (uint32 array).")
+      .def("transform", &bowVectorOf, "descriptors"_a,
+           "The L1-normalised bag-of-words vector {word id: weight} of a set of descriptors.")
       .def("__repr__", [](const OrbVocabulary& v) {
         return "Vocabulary(k=" + std::to_string(v.branching()) + ", L=" + std::to_string(v.depth()) +
                ", words=" + std::to_string(v.wordCount()) + ")";

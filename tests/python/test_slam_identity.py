@@ -93,3 +93,15 @@ def test_saved_map_relocalises_in_localisation_mode(synthetic: Path, cli_run: Pa
     assert stats["keyframes"] == stats["keyframes_loaded"]  # localisation only: no new keyframes
     with pytest.raises(orbis.Error, match="shutdown"):
         slam.track(data[41])
+
+
+def test_dataset_frames_share_their_pixels(synthetic: Path) -> None:
+    data = orbis.datasets.tum(synthetic)
+    frame = data[-1]
+    assert frame.index == len(data) - 1 == 59 and frame.timestamp == data.timestamps[-1]
+    assert np.shares_memory(frame.image, frame.left) and not frame.image.flags.owndata  # views of one cv::Mat
+    assert frame.image.dtype == np.uint8 and frame.image.shape[:2] == (240, 320)
+    assert frame.depth.dtype == np.uint16 and frame.depth.shape == (240, 320) and frame.right is None
+    assert data.ground_truth.shape == (60, 8)
+    with pytest.raises(IndexError):
+        data[60]
