@@ -124,19 +124,6 @@ py::array_t<double> poseToArray(const SE3d& pose) {
   return out;
 }
 
-SE3d poseFromArray(const py::handle& value, const char* argument) {
-  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
-  if (!a) throw py::type_error(std::string(argument) + ": expected a 4 x 4 numeric array");
-  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4)
-    throw py::value_error(std::string(argument) + ": expected shape (4, 4), got " + describe(a));
-  Eigen::Matrix4d m;
-  auto v = a.unchecked<2>();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = v(r, c);
-  if (!m.allFinite()) throw py::value_error(std::string(argument) + ": not finite");
-  return SE3d::fromMatrix(m);
-}
-
 py::array_t<double> trajectoryToArray(const Trajectory& trajectory) {
   py::array_t<double> out({static_cast<py::ssize_t>(trajectory.size()), py::ssize_t{8}});
   auto rows = out.mutable_unchecked<2>();

@@ -39,7 +39,6 @@ ImageView descriptorView(const py::handle& array, const char* argument);
 py::object matToArray(const cv::Mat& mat);
 
 py::array_t<double> poseToArray(const SE3d& pose);
-SE3d poseFromArray(const py::handle& matrix, const char* argument);
 
 py::array_t<double> trajectoryToArray(const Trajectory& trajectory);
 Trajectory trajectoryFromArray(const py::handle& rows, const char* argument);
