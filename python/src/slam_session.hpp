@@ -1,0 +1,116 @@
+// python/src/slam_session.hpp — one Python Slam object: orbis::Slam<Sensor> plus what the
+// binding must guard (a mutex, the shutdown flag, the last timestamp, the camera's image size).
+//
+// Contract: track() is called with the GIL held, checks the input against the camera, then
+// releases the GIL, locks the session and tracks; locked(fn) runs any other query or command the
+// same way, and keeps each call's C++ time (trackTimes). The destructor joins the mapping threads without the GIL. Input errors raise
+// ValueError (size, timestamp); tracking after shutdown() raises orbis.Error.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "arrays.hpp"
+#include "orbis/system/slam.hpp"
+#include "orbis/util/error.hpp"
+
+namespace orbis::python {
+
+namespace py = pybind11;
+
+inline std::array<const cv::Mat*, 2> inputImages(const StereoInput& in) { return {&in.left, &in.right}; }
+inline std::array<const cv::Mat*, 2> inputImages(const RgbdInput& in) { return {&in.image, &in.depth}; }
+
+template <class Sensor>
+class SlamSession {
+ public:
+  using Camera = typename Sensor::Camera;
+
+  SlamSession(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
+              const SlamOptions& options)
+      : camera_(camera), localisationOnly_(options.localisationOnly),
+        slam_(std::make_unique<Slam<Sensor>>(camera, orb, std::move(vocabulary), options)) {}
+
+  ~SlamSession() {
+    if (PyGILState_Check()) {
+      py::gil_scoped_release release;  // joining the mapping threads needs no Python
+      slam_.reset();
+    }
+  }
+
+  // Called with the GIL held; validates, then tracks without it.
+  py::tuple track(const typename Sensor::Input& input) {
+    checkSize(input);
+    TrackResult result;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard lock(mutex_);
+      if (shutDown_) throw Error("slam", "", "track() after shutdown()");
+      if (!std::isfinite(input.timestamp) || !(input.timestamp > lastTimestamp_))
+        throw py::value_error("timestamp " + std::to_string(input.timestamp) + " does not increase (last " +
+                              std::to_string(lastTimestamp_) + ")");
+      lastTimestamp_ = input.timestamp;
+      const auto start = std::chrono::steady_clock::now();
+      result = slam_->track(input);
+      trackMs_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    }
+    py::object pose = py::none();
+    if (result.state == TrackingState::Ok) pose = poseToArray(result.Tcw.inverse());
+    return py::make_tuple(result.state, pose);
+  }
+
+  // Runs fn(slam) with the GIL released and the session locked; returns what it returns.
+  template <class Fn>
+  auto locked(Fn&& fn) {
+    py::gil_scoped_release release;
+    std::lock_guard lock(mutex_);
+    return fn(*slam_);
+  }
+
+  void shutdown() {
+    locked([](Slam<Sensor>& s) { s.shutdown(); });
+    shutDown_ = true;
+  }
+  void setLocalisationOnly(bool on) {
+    locked([on](Slam<Sensor>& s) { s.setLocalisationOnly(on); });
+    localisationOnly_ = on;
+  }
+  bool localisationOnly() const { return localisationOnly_; }
+  // Wall time of each track() call's C++ part (Slam::track), ms: the binding's cost is a call's
+  // time seen from Python minus this.
+  std::vector<double> trackTimes() {
+    return locked([this](Slam<Sensor>&) { return trackMs_; });
+  }
+  const Camera& camera() const { return camera_; }
+
+ private:
+  void checkSize(const typename Sensor::Input& input) const {
+    const cv::Size expected(camera_.pinhole.width, camera_.pinhole.height);
+    for (const cv::Mat* image : inputImages(input)) {
+      if (expected.width > 0 && expected.height > 0 && image->size() != expected)
+        throw py::value_error("image of " + std::to_string(image->cols) + " x " + std::to_string(image->rows) +
+                              " pixels; the camera is " + std::to_string(expected.width) + " x " +
+                              std::to_string(expected.height));
+      if (image->size() != inputImages(input)[0]->size())
+        throw py::value_error("the two images of a frame differ in size");
+    }
+  }
+
+  Camera camera_;
+  bool localisationOnly_;
+  std::unique_ptr<Slam<Sensor>> slam_;
+  std::mutex mutex_;
+  double lastTimestamp_ = -std::numeric_limits<double>::infinity();
+  bool shutDown_ = false;
+  std::vector<double> trackMs_;
+};
+
+}  // namespace orbis::python
