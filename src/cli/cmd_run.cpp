@@ -7,9 +7,23 @@
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
+#include "orbis/util/warnings.hpp"
 
 namespace orbis::cli {
 namespace {
+
+// A run that tracked nothing has failed, whatever it wrote: say why, and exit non-zero.
+void requireSomethingTracked(const DatasetReader& dataset, const RunReport& r) {
+  const std::string root = dataset.root().string();
+  if (dataset.size() == 0) throw Error(root, "", "the sequence lists no frame: nothing to run");
+  if (r.stats.frames == 0)
+    throw Error(root, "", "none of the " + std::to_string(dataset.size()) +
+                              " frames could be processed (every one was skipped; the warnings above say why)");
+  if (r.stats.tracked == 0)
+    throw Error(root, "", "none of the " + std::to_string(r.stats.frames) +
+                              " frames processed was tracked: check the camera calibration (--settings FILE), "
+                              "the vocabulary (--vocab) and that the images are not blank");
+}
 
 int runCommand(const std::vector<std::string>& args) {
   ArgParser p("orbis run tum|euroc|kitti PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
@@ -55,6 +69,7 @@ int runCommand(const std::vector<std::string>& args) {
   if (p.has("--json")) {
     std::ifstream in(options.outDir / "report.json");
     std::printf("%s", std::string(std::istreambuf_iterator<char>(in), {}).c_str());
+    requireSomethingTracked(*dataset, r);
     return 0;
   }
   std::printf("dataset        %s (%s)\n", r.dataset.c_str(), r.sensor.c_str());
@@ -71,9 +86,10 @@ int runCommand(const std::vector<std::string>& args) {
   std::printf("\n%-32s %7s %9s %9s %9s\n", "stage", "count", "mean ms", "median", "p95");
   for (const StageStats& s : r.timing)
     std::printf("%-32s %7zu %9.2f %9.2f %9.2f\n", s.stage.c_str(), s.count, s.meanMs, s.medianMs, s.p95Ms);
-  for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const auto& w : readableWarnings(foldWarnings(r.warnings))) std::fprintf(stderr, "warning: %s\n", w.c_str());
   std::printf("\noutputs in %s (trajectory.txt, keyframes.txt, report.json, map.ply, overview.png)\n",
               options.outDir.string().c_str());
+  requireSomethingTracked(*dataset, r);
   return 0;
 }
 

@@ -4,8 +4,10 @@
 // Contract: openDataset reads only the small text files (lists, timestamps, calibration,
 // ground truth) and checks them; images are loaded when a frame is asked for, so a whole
 // sequence is never held in memory. Frames come in time order; frame(i) may be called in any
-// order. A missing file, an unreadable image, a malformed line or timestamps out of order
-// throw orbis::Error naming the file (and the line, for text files). A missing right image or
+// order. A missing file, an unreadable image or a malformed line throws orbis::Error naming
+// the file (and the line, for text files). Lists and ground truth whose rows are out of time
+// order are sorted, and of rows with equal timestamps the first is kept, each kind of repair
+// one entry in DatasetReader::warnings() with its count. A missing right image or
 // depth map is reported on the frame (DatasetFrame::warnings) or, with DatasetOptions::strict,
 // thrown; it is never skipped silently. Ground truth is given as camera-to-world poses of the
 // left (or colour) camera — for EuRoC, of the rectified left camera when rectifying.
@@ -57,8 +59,8 @@ struct DatasetOptions {
   bool rectify = true;        // EuRoC: deliver rectified images and calibration (what the pipeline eats)
   bool strict = false;        // a missing right image or depth map throws instead of warning
   // A long run should survive a bad frame: a listed left/colour image that does not exist is then
-  // an error of that frame only (frame(i) throws, naming list file and line), and a list row whose
-  // timestamp does not increase is dropped with a warning (DatasetReader::warnings()).
+  // an error of that frame only (frame(i) throws, naming list file and line) instead of an error
+  // when opening.
   bool tolerateBadFrames = false;
   std::string kittiSequence;  // KITTI: "06" when root holds several sequences
 };
@@ -93,7 +95,7 @@ class DatasetReader {
   // or undistorted already): TUM freiburg1/2 images are distorted.
   virtual RadTanDistortion<double> distortion() const { return {}; }
   virtual const std::filesystem::path& root() const = 0;
-  // What was found wrong, and survived, while opening (DatasetOptions::tolerateBadFrames).
+  // What was found wrong, and survived, while opening (rows put in time order, ...).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
   // Sequential reading: the next frame, or nothing past the end.
