@@ -12,7 +12,8 @@ DatasetKind parseDatasetKind(std::string_view name, const std::string& source) {
   if (name == "tum") return DatasetKind::TumRgbd;
   if (name == "euroc") return DatasetKind::Euroc;
   if (name == "kitti") return DatasetKind::Kitti;
-  throw Error(source, "", "unknown dataset kind '" + std::string(name) + "' (expected tum, euroc or kitti)");
+  if (name == "kitti-raw") return DatasetKind::KittiRaw;
+  throw Error(source, "", "unknown dataset kind '" + std::string(name) + "' (expected tum, euroc, kitti or kitti-raw)");
 }
 
 std::string_view toString(DatasetKind kind) {
@@ -23,6 +24,8 @@ std::string_view toString(DatasetKind kind) {
       return "euroc";
     case DatasetKind::Kitti:
       return "kitti";
+    case DatasetKind::KittiRaw:
+      return "kitti-raw";
   }
   return "?";
 }
@@ -51,6 +54,7 @@ std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root) 
   if (fs::exists(root / "rgb.txt")) return DatasetKind::TumRgbd;
   if (fs::exists(root / "mav0") || fs::exists(root / "cam0" / "data.csv")) return DatasetKind::Euroc;
   if (fs::exists(root / "sequences") || fs::exists(root / "times.txt")) return DatasetKind::Kitti;
+  if (fs::exists(root / "image_00" / "timestamps.txt")) return DatasetKind::KittiRaw;
   return std::nullopt;
 }
 
@@ -63,6 +67,8 @@ std::unique_ptr<DatasetReader> openDataset(DatasetKind kind, const std::filesyst
       return openEuroc(root, options);
     case DatasetKind::Kitti:
       return openKitti(root, options);
+    case DatasetKind::KittiRaw:
+      return openKittiRaw(root, options);
   }
   throw Error(root.string(), "", "unknown dataset kind");
 }

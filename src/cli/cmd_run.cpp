@@ -12,6 +12,14 @@
 namespace orbis::cli {
 namespace {
 
+// Before the run, so an unwritable --out fails at once rather than after the sequence.
+void createOutputFolder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw Error(dir.string(), "", "cannot create the output folder (" + (ec ? ec.message() : "not a folder") + ")");
+}
+
 // A run that tracked nothing has failed, whatever it wrote: say why, and exit non-zero.
 void requireSomethingTracked(const DatasetReader& dataset, const RunReport& r) {
   const std::string root = dataset.root().string();
@@ -26,10 +34,11 @@ void requireSomethingTracked(const DatasetReader& dataset, const RunReport& r) {
 }
 
 int runCommand(const std::vector<std::string>& args) {
-  ArgParser p("orbis run tum|euroc|kitti PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
+  ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
               "Runs SLAM over a dataset sequence and writes DIR/trajectory.txt, keyframes.txt, report.json,\n"
-              "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.");
-  p.positional("DATASET", "tum, euroc or kitti (the on-disk layout)")
+              "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.\n"
+              "kitti-raw PATH is a raw drive folder (image_00, image_01, oxts) with the calib_*.txt files beside it.");
+  p.positional("DATASET", "tum, euroc, kitti or kitti-raw (the on-disk layout)")
       .positional("PATH", "the sequence folder")
       .option("--settings", "FILE", "ORB-SLAM2 settings YAML (camera, ORBextractor.*); default: the dataset's calibration")
       .option("--vocab", "FILE", "vocabulary (orbis binary); default: the shipped one")
@@ -54,6 +63,7 @@ int runCommand(const std::vector<std::string>& args) {
   if (auto s = p.getOptional("--settings")) options.settings = *s;
   options.vocabulary = p.has("--vocab") ? std::filesystem::path(p.get("--vocab")) : defaultVocabularyPath();
   options.outDir = p.get("--out");
+  createOutputFolder(options.outDir);
   options.deterministic = p.has("--deterministic");
   options.localisationOnly = p.has("--localize");
   options.loopClosing = !p.has("--no-loop");
@@ -93,7 +103,7 @@ int runCommand(const std::vector<std::string>& args) {
   return 0;
 }
 
-ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI)", runCommand);
+ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI odometry and raw)", runCommand);
 
 }  // namespace
 }  // namespace orbis::cli

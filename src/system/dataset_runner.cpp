@@ -48,7 +48,8 @@ Defaults datasetDefaults(DatasetKind kind) {
   switch (kind) {
     case DatasetKind::TumRgbd: return {1000, 30};
     case DatasetKind::Euroc: return {1200, 20};
-    case DatasetKind::Kitti: return {2000, 10};
+    case DatasetKind::Kitti:
+    case DatasetKind::KittiRaw: return {2000, 10};
   }
   return {1000, 30};
 }

@@ -12,9 +12,9 @@
 #include "orbis/adapters/dataset.hpp"
 #include "orbis/camera/euroc_calibration.hpp"
 #include "orbis/io/trajectory.hpp"
-#include "orbis/synth/writers.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/util/error.hpp"
+#include "rendered_sequence.hpp"
 
 namespace {
 
@@ -45,15 +45,7 @@ class PublishedVariants : public ::testing::Test {
     static const fs::path rendered = [] {
       const fs::path dir = fs::temp_directory_path() / ("orbis_variants_euroc_" + std::to_string(::getpid()));
       fs::remove_all(dir);
-      orbis::synth::SynthOptions o;
-      o.frames = 150;
-      o.width = 320;
-      o.height = 240;
-      o.fx = 250.0;
-      o.seed = 5;
-      o.threads = 2;
-      orbis::synth::SyntheticSequence sequence(o);
-      orbis::synth::writeSynthSequence(sequence, orbis::synth::SynthLayout::Euroc, dir);
+      orbis::test::renderSmallLoop(orbis::synth::SynthLayout::Euroc, dir, 5);
       return dir;
     }();
     fs::copy(rendered, root_, fs::copy_options::recursive);

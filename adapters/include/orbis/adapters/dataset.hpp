@@ -31,15 +31,16 @@
 
 namespace orbis {
 
-enum class DatasetKind { TumRgbd, Euroc, Kitti };
+enum class DatasetKind { TumRgbd, Euroc, Kitti, KittiRaw };
 // SensorKind: orbis/camera/sensor_kind.hpp (shared with the dataset readers).
 
-// "tum", "euroc", "kitti"; throws orbis::Error(source) otherwise.
+// "tum", "euroc", "kitti", "kitti-raw"; throws orbis::Error(source) otherwise.
 DatasetKind parseDatasetKind(std::string_view name, const std::string& source = "dataset kind");
 std::string_view toString(DatasetKind kind);
 SensorKind parseSensorKind(std::string_view name, const std::string& source = "sensor");
 std::string_view toString(SensorKind sensor);
-// Recognises a dataset folder by its files (rgb.txt; mav0/; sequences/ or times.txt).
+// Recognises a dataset folder by its files (rgb.txt; mav0/; sequences/ or times.txt;
+// image_00/timestamps.txt for a KITTI raw drive).
 std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root);
 
 struct DatasetOptions {
@@ -119,5 +120,9 @@ std::unique_ptr<DatasetReader> openDataset(DatasetKind kind, const std::filesyst
 std::unique_ptr<DatasetReader> openTumRgbd(const std::filesystem::path& root, const DatasetOptions& options);
 std::unique_ptr<DatasetReader> openEuroc(const std::filesystem::path& root, const DatasetOptions& options);
 std::unique_ptr<DatasetReader> openKitti(const std::filesystem::path& root, const DatasetOptions& options);
+// A KITTI raw drive folder (2011_09_26_drive_0001_sync: image_00/, image_01/, oxts/) with the
+// calib_*.txt files beside it (the date folder) or in it. Ground truth: the OXTS poses as
+// rectified left-camera poses, the first camera being the world.
+std::unique_ptr<DatasetReader> openKittiRaw(const std::filesystem::path& root, const DatasetOptions& options);
 
 }  // namespace orbis
