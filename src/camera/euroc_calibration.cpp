@@ -1,114 +1,18 @@
 // EuRoC sensor.yaml reader; see orbis/camera/euroc_calibration.hpp.
 //
 // The files ASL publishes are plain YAML starting with a comment; OpenCV's FileStorage refuses
-// them (it wants its own "%YAML:1.0" first line), so they are read with yaml-cpp, which also
-// takes the copies that have that line added (it skips an unknown directive).
+// them (it wants its own "%YAML:1.0" first line): YamlReader (yaml-cpp) takes them, and the
+// copies that have that line added.
 #include "orbis/camera/euroc_calibration.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
-#include <fstream>
-#include <optional>
-#include <sstream>
-#include <string>
-#include <vector>
 
-#include "orbis/util/error.hpp"
+#include "yaml_reader.hpp"
 
 namespace orbis {
-namespace {
-
-class SensorYaml {
- public:
-  explicit SensorYaml(const std::filesystem::path& file) : path_(file.string()) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec)) throw fileError(path_, "no such file");
-    std::ifstream in(file, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    if (!in) throw fileError(path_, "cannot be read");
-    if (text.str().find_first_not_of(" \t\r\n") == std::string::npos)
-      throw fileError(path_, "empty file, expected a EuRoC camera description (YAML)");
-    try {
-      root_ = YAML::Load(text.str());
-    } catch (const YAML::Exception& e) {
-      throw lineError(path_, static_cast<std::size_t>(e.mark.line) + 1, "not valid YAML: " + e.msg);
-    }
-    if (!root_.IsMap()) throw fileError(path_, "expected a YAML map of keys at the top level");
-  }
-
-  Error error(const std::string& key, const std::string& what) const { return keyError(path_, key, what); }
-
-  std::optional<std::string> optionalString(const std::string& key) const {
-    const YAML::Node n = root_[key];
-    if (!n) return std::nullopt;
-    if (!n.IsScalar()) throw error(key, "expected text, found " + describe(n));
-    return n.Scalar();
-  }
-
-  // A YAML sequence of numbers whose length lies in [minCount, maxCount].
-  std::vector<double> reals(const std::string& key, std::size_t minCount, std::size_t maxCount) const {
-    return numbers(required(root_, key), key, minCount, maxCount);
-  }
-
-  // A map with rows, cols and data (row-major), of exactly the given size.
-  Eigen::MatrixXd matrix(const std::string& key, int rows, int cols) const {
-    const YAML::Node n = required(root_, key);
-    if (!n.IsMap()) throw error(key, "expected a matrix (a map with rows, cols and data), found " + describe(n));
-    const double r = number(required(n, "rows", key), key + ".rows");
-    const double c = number(required(n, "cols", key), key + ".cols");
-    if (r != rows || c != cols)
-      throw error(key, "expected a " + std::to_string(rows) + "x" + std::to_string(cols) + " matrix");
-    const std::size_t count = static_cast<std::size_t>(rows * cols);
-    const std::vector<double> data = numbers(required(n, "data", key), key + ".data", count, count);
-    Eigen::MatrixXd m(rows, cols);
-    for (std::size_t i = 0; i < count; ++i) m(static_cast<int>(i) / cols, static_cast<int>(i) % cols) = data[i];
-    return m;
-  }
-
- private:
-  static std::string describe(const YAML::Node& n) {
-    if (n.IsSequence()) return "a sequence";
-    if (n.IsMap()) return "a map";
-    if (n.IsNull()) return "no value";
-    return "the text \"" + n.Scalar() + "\"";
-  }
-
-  YAML::Node required(const YAML::Node& parent, const std::string& key, const std::string& prefix = {}) const {
-    const YAML::Node n = parent[key];
-    if (!n) throw error(prefix.empty() ? key : prefix + "." + key, "missing");
-    return n;
-  }
-
-  double number(const YAML::Node& n, const std::string& key) const {
-    double value = 0.0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, value))
-      throw error(key, "expected a number, found " + describe(n));
-    if (!std::isfinite(value)) throw error(key, "expected a finite number");
-    return value;
-  }
-
-  std::vector<double> numbers(const YAML::Node& n, const std::string& key, std::size_t minCount,
-                              std::size_t maxCount) const {
-    if (!n.IsSequence()) throw error(key, "expected a sequence of numbers, found " + describe(n));
-    if (n.size() < minCount || n.size() > maxCount)
-      throw error(key, "expected " + std::to_string(minCount) +
-                           (maxCount != minCount ? " to " + std::to_string(maxCount) : "") + " numbers, found " +
-                           std::to_string(n.size()));
-    std::vector<double> values;
-    for (const YAML::Node& item : n) values.push_back(number(item, key));
-    return values;
-  }
-
-  std::string path_;
-  YAML::Node root_;
-};
-
-}  // namespace
 
 CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml) {
-  const SensorYaml yaml(sensorYaml);
+  const detail::YamlReader yaml(sensorYaml, detail::YamlReader::Header::Optional);
   if (const auto model = yaml.optionalString("camera_model"); model && *model != "pinhole") {
     throw yaml.error("camera_model", "only pinhole is supported, found \"" + *model + "\"");
   }
