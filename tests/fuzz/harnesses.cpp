@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -12,6 +13,7 @@
 #include "orbis/adapters/dataset.hpp"
 #include "orbis/bow/dbow2_text.hpp"
 #include "orbis/bow/vocabulary.hpp"
+#include "orbis/bow/vocabulary_file.hpp"
 #include "orbis/camera/euroc_calibration.hpp"
 #include "orbis/io/bal.hpp"
 #include "orbis/io/settings.hpp"
@@ -145,6 +147,16 @@ void vocabularyBinary(const std::uint8_t* data, std::size_t size) {
   bow::OrbVocabulary::load(writeFile("vocabulary.bin", data, size));
 }
 
+// The same with the checksum trailer recomputed, so mutations reach the structure checks behind it.
+void vocabularyBinaryResealed(const std::uint8_t* data, std::size_t size) {
+  std::vector<std::uint8_t> bytes(data, data + size);
+  if (bytes.size() >= 72) {
+    const std::uint64_t sum = bow::checksum64(bytes.data(), bytes.size() - 8);
+    std::memcpy(bytes.data() + bytes.size() - 8, &sum, sizeof sum);  // little-endian, as the format
+  }
+  bow::OrbVocabulary::load(writeFile("vocabulary_resealed.bin", bytes.data(), bytes.size()));
+}
+
 void vocabularyText(const std::uint8_t* data, std::size_t size) {
   bow::readDbow2Text<bow::OrbVocabulary>(writeFile("vocabulary.txt", data, size));
 }
@@ -168,6 +180,7 @@ const std::vector<Harness>& harnesses() {
       {"kitti_raw_oxts", kittiRawOxts},
       {"kitti_raw_timestamps", kittiRawTimestamps},
       {"vocabulary_binary", vocabularyBinary},
+      {"vocabulary_binary_resealed", vocabularyBinaryResealed},
       {"vocabulary_text", vocabularyText},
   };
   return all;
