@@ -11,7 +11,8 @@ namespace orbis {
 
 namespace {
 constexpr EnumName<DatasetKind> kDatasetKindNames[] = {
-    {DatasetKind::TumRgbd, "tum"}, {DatasetKind::Euroc, "euroc"}, {DatasetKind::Kitti, "kitti"}};
+    {DatasetKind::TumRgbd, "tum"}, {DatasetKind::Euroc, "euroc"}, {DatasetKind::Kitti, "kitti"},
+    {DatasetKind::KittiRaw, "kitti-raw"}};
 }  // namespace
 
 DatasetKind parseDatasetKind(std::string_view name, const std::string& source) {
@@ -25,6 +26,7 @@ std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root) 
   if (fs::exists(root / "rgb.txt")) return DatasetKind::TumRgbd;
   if (fs::exists(root / "mav0") || fs::exists(root / "cam0" / "data.csv")) return DatasetKind::Euroc;
   if (fs::exists(root / "sequences") || fs::exists(root / "times.txt")) return DatasetKind::Kitti;
+  if (fs::exists(root / "image_00" / "timestamps.txt")) return DatasetKind::KittiRaw;
   return std::nullopt;
 }
 
@@ -37,6 +39,8 @@ std::unique_ptr<DatasetReader> openDataset(DatasetKind kind, const std::filesyst
       return openEuroc(root, options);
     case DatasetKind::Kitti:
       return openKitti(root, options);
+    case DatasetKind::KittiRaw:
+      return openKittiRaw(root, options);
   }
   throw Error(root.string(), "", "unknown dataset kind");
 }
@@ -49,8 +53,8 @@ void requireExists(const std::filesystem::path& path, const std::string& what) {
 
 std::vector<ListedImage> readImageList(const std::filesystem::path& listFile,
                                        const std::filesystem::path& imageDir, TimeUnit unit,
-                                       bool requireImages, std::vector<std::string>* droppedRows) {
-  std::vector<ListedImage> images;
+                                       bool requireImages, std::vector<std::string>& warnings) {
+  std::vector<ListedImage> rows;
   forEachTextRow(listFile, [&](const TextRow& row) {
     if (row.fields.size() != 2)
       throw lineError(listFile.string(), row.line,
@@ -59,20 +63,25 @@ std::vector<ListedImage> readImageList(const std::filesystem::path& listFile,
     image.t = unit == TimeUnit::Seconds
                   ? parseDouble(row.fields[0], listFile, row.line)
                   : static_cast<double>(parseInteger(row.fields[0], listFile, row.line)) * 1e-9;
-    if (!images.empty() && !(image.t > images.back().t)) {
-      const std::string what = "timestamp " + std::string(row.fields[0]) + " is not after the previous row's";
-      if (!droppedRows) throw lineError(listFile.string(), row.line, what);
-      droppedRows->push_back(listFile.string() + ", line " + std::to_string(row.line) + ": " + what + "; row skipped");
-      return;
-    }
     image.file = imageDir / std::string(row.fields[1]);
     image.listFile = listFile;
     image.line = row.line;
     image.exists = std::filesystem::exists(image.file);
     if (requireImages && !image.exists)
       throw lineError(listFile.string(), row.line, "image " + image.file.string() + " does not exist");
-    images.push_back(std::move(image));
+    rows.push_back(std::move(image));
   });
+  std::vector<double> times;
+  std::vector<std::size_t> lines;
+  for (const ListedImage& image : rows) {
+    times.push_back(image.t);
+    lines.push_back(image.line);
+  }
+  const TimeOrder order = putInTimeOrder(times, lines);
+  for (std::string& w : order.warnings(listFile)) warnings.push_back(std::move(w));
+  std::vector<ListedImage> images;
+  images.reserve(order.keep.size());
+  for (const std::size_t i : order.keep) images.push_back(std::move(rows[i]));
   return images;
 }
 
@@ -85,7 +94,9 @@ cv::Mat loadImage(const std::filesystem::path& file, int imreadFlags, const std:
     image.release();
   }
   if (image.empty()) {
-    const std::string what = "cannot read the image " + file.string();
+    const std::string what = std::filesystem::exists(file)
+                                 ? "cannot read the image " + file.string() + " (truncated or not an image)"
+                                 : "image " + file.string() + " does not exist";
     if (!listFile.empty()) throw lineError(listFile.string(), line, what);
     throw fileError(file.string(), "cannot read the image (missing, truncated or not an image)");
   }
@@ -138,6 +149,12 @@ const ListedImage* PairedImages::find(const std::vector<ListedImage>& primary, s
     return nullptr;
   }
   return &partner;
+}
+
+std::size_t PairedImages::pairedOnDisk() const {
+  std::size_t count = 0;
+  for (const std::size_t partner : partnerOf_) count += partner != kNone && partners_[partner].exists;
+  return count;
 }
 
 void PairedImages::requireAll(const std::vector<ListedImage>& primary) const {

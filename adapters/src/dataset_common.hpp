@@ -23,13 +23,13 @@ struct ListedImage {
 
 enum class TimeUnit { Seconds, Nanoseconds };
 
-// Reads the list, checks every row (two fields, a number, strictly increasing times) and
-// whether each image exists. When requireImages, a missing image throws naming list and line.
-// With droppedRows, a row whose time does not increase is dropped and described there instead
-// of thrown.
+// Reads the list and checks every row (two fields, a number) and whether each image exists.
+// When requireImages, a missing image throws naming list and line. Rows out of time order are
+// sorted, and of rows with equal timestamps the first is kept; `warnings` gets one line per
+// kind of repair.
 std::vector<ListedImage> readImageList(const std::filesystem::path& listFile,
                                        const std::filesystem::path& imageDir, TimeUnit unit,
-                                       bool requireImages, std::vector<std::string>* droppedRows = nullptr);
+                                       bool requireImages, std::vector<std::string>& warnings);
 
 // Throws orbis::Error naming the file (and where it was listed, if known) when unreadable.
 cv::Mat loadImage(const std::filesystem::path& file, int imreadFlags,
@@ -59,6 +59,9 @@ class PairedImages {
                           std::vector<std::string>& warnings, bool strict) const;
   // Throws orbis::Error for the first primary image without a partner on disk.
   void requireAll(const std::vector<ListedImage>& primary) const;
+  // How many primary images have a partner on disk; how many partners were listed at all.
+  std::size_t pairedOnDisk() const;
+  std::size_t listed() const { return partners_.size(); }
 
  private:
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);

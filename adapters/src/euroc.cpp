@@ -31,24 +31,26 @@ class EurocReader final : public DatasetReader {
     const fs::path mav = fs::exists(root / "mav0") ? root / "mav0" : root;
     requireExists(mav / "cam0", "the EuRoC cam0 folder");
     left_ = readImageList(mav / "cam0" / "data.csv", mav / "cam0" / "data", TimeUnit::Nanoseconds,
-                          !options.tolerateBadFrames, options.tolerateBadFrames ? &warnings_ : nullptr);
+                          !options.tolerateBadFrames, warnings_);
     leftSensor_ = readEurocCalibration(mav / "cam0" / "sensor.yaml");
     if (sensor_ == SensorKind::Stereo) {
       std::vector<ListedImage> right =
-          readImageList(mav / "cam1" / "data.csv", mav / "cam1" / "data", TimeUnit::Nanoseconds, false,
-                        options.tolerateBadFrames ? &warnings_ : nullptr);
+          readImageList(mav / "cam1" / "data.csv", mav / "cam1" / "data", TimeUnit::Nanoseconds, false, warnings_);
       right_ = PairedImages(left_, std::move(right), options.maxStereoDt, "cam1 image");
       rightSensor_ = readEurocCalibration(mav / "cam1" / "sensor.yaml");
       if (options.strict) right_.requireAll(left_);
     }
     if (options.rectify) prepareRectification();
 
-    const fs::path gtFile = mav / "state_groundtruth_estimate0" / "data.csv";
+    // The ground truth as published (data.csv, 17 columns) or converted to TUM form, by evo
+    // (data.tum) or by hand into data.csv: both carry body poses.
+    fs::path gtFile = mav / "state_groundtruth_estimate0" / "data.csv";
+    if (!fs::exists(gtFile)) gtFile.replace_extension(".tum");
     if (fs::exists(gtFile)) {
       // Body poses T_WB to left-camera poses T_WC = T_WB T_BS, then to the rectified left
       // camera: rectification rotates the camera by R1 (x_rect = R1 x_cam).
       const SE3d cameraFromRectified(rectifiedRotation_.transpose(), Eigen::Vector3d::Zero());
-      groundTruth_ = readTrajectory(gtFile, TrajectoryFormat::Euroc);
+      groundTruth_ = readTrajectory(gtFile, detectTrajectoryFormat(gtFile), {}, &warnings_);
       const SE3d bodyFromCamera = toPose(leftSensor_.bodyFromCamera);
       for (StampedPose& sp : groundTruth_) sp.pose = sp.pose * bodyFromCamera * cameraFromRectified;
     }

@@ -1,9 +1,6 @@
 // KITTI odometry reader: sequences/NN/{image_0, image_1 (optional), times.txt, calib.txt} and
 // poses/NN.txt (optional: sequences 11-21 have no public ground truth).
-#include <cstdio>
-#include <opencv2/imgcodecs.hpp>
-
-#include "dataset_common.hpp"
+#include "kitti_common.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis {
@@ -39,111 +36,26 @@ KittiLayout locate(const fs::path& root, const std::string& sequence) {
   return {sequences / chosen, root / "poses" / (chosen + ".txt")};
 }
 
-// calib.txt rows "P0: p00 ... p23"; returns the 3x4 projection named key.
-Eigen::Matrix<double, 3, 4> readProjection(const fs::path& calibFile, const std::string& key) {
-  Eigen::Matrix<double, 3, 4> projection;
-  bool found = false;
-  forEachTextRow(calibFile, [&](const TextRow& row) {
-    if (row.fields.front() != key + ":") return;
-    if (row.fields.size() != 13)
-      throw lineError(
-          calibFile.string(), row.line,
-          "expected " + key + ": followed by 12 numbers, found " + std::to_string(row.fields.size() - 1));
-    for (int i = 0; i < 12; ++i)
-      projection(i / 4, i % 4) = parseDouble(row.fields[i + 1], calibFile, row.line);
-    found = true;
-  });
-  if (!found) throw keyError(calibFile.string(), key, "missing");
-  return projection;
-}
-
-class KittiReader final : public DatasetReader {
+// calib.txt rows "P0: p00 ... p23" (P2, P3 and the velodyne's Tr are not needed).
+class KittiReader final : public KittiImagesReader {
  public:
-  KittiReader(const fs::path& root, const DatasetOptions& options) : root_(root), options_(options) {
+  KittiReader(const fs::path& root, const DatasetOptions& options) {
     const KittiLayout layout = locate(root, options.kittiSequence);
-    sequenceDir_ = layout.sequenceDir;
-    const fs::path timesFile = sequenceDir_ / "times.txt";
+    const fs::path timesFile = layout.sequenceDir / "times.txt";
     requireExists(timesFile, "the KITTI times file");
-    timesFile_ = timesFile;
-    times_ = readTimestamps(timesFile);
-    const bool hasRight = fs::is_directory(sequenceDir_ / "image_1");
-    sensor_ = options.sensor.value_or(hasRight ? SensorKind::Stereo : SensorKind::Monocular);
-    if (sensor_ == SensorKind::Rgbd)
-      throw Error(root.string(), "", "KITTI has no depth maps (use stereo or mono)");
-    if (sensor_ == SensorKind::Stereo && !hasRight)
-      throw fileError((sequenceDir_ / "image_1").string(), "does not exist (stereo needs the right images)");
-
-    for (std::size_t i = 0; i < times_.size(); ++i) {
-      if (!options.tolerateBadFrames && !fs::exists(imagePath(0, i)))
-        throw lineError(timesFile.string(), i + 1, "image " + imagePath(0, i).string() + " does not exist");
-      if (sensor_ == SensorKind::Stereo && options.strict && !fs::exists(imagePath(1, i)))
-        throw lineError(timesFile.string(), i + 1,
-                        "right image " + imagePath(1, i).string() + " does not exist");
-    }
-
-    const fs::path calibFile = sequenceDir_ / "calib.txt";
+    openImages(root,
+               {timesFile, readTimestamps(timesFile), layout.sequenceDir / "image_0", layout.sequenceDir / "image_1", 6},
+               options);
+    const fs::path calibFile = layout.sequenceDir / "calib.txt";
     requireExists(calibFile, "the KITTI calibration");
-    const Eigen::Matrix<double, 3, 4> p0 = readProjection(calibFile, "P0");
-    pinhole_.fx = p0(0, 0);
-    pinhole_.fy = p0(1, 1);
-    pinhole_.cx = p0(0, 2);
-    pinhole_.cy = p0(1, 2);
-    const cv::Mat first = loadImage(imagePath(0, 0), cv::IMREAD_UNCHANGED, timesFile, 1);
-    pinhole_.width = first.cols;
-    pinhole_.height = first.rows;
-    if (sensor_ == SensorKind::Stereo) {
-      const Eigen::Matrix<double, 3, 4> p1 = readProjection(calibFile, "P1");
-      baseline_ = -p1(0, 3) / p1(0, 0);  // P1 = K [I | -b e_x]
-      if (!(baseline_ > 0)) throw keyError(calibFile.string(), "P1", "gives a non-positive baseline");
-    }
-
-    if (fs::exists(layout.posesFile)) {
+    const std::vector<double> left = readCalibrationRow(calibFile, "P0", 12);  // first: errors in file order
+    setCamera(left, sensor_ == SensorKind::Stereo ? readCalibrationRow(calibFile, "P1", 12) : std::vector<double>{},
+              calibFile, "P1");
+    if (fs::exists(layout.posesFile))
       groundTruth_ = readTrajectory(layout.posesFile, TrajectoryFormat::Kitti, timesFile);
-    }
   }
 
   DatasetKind kind() const override { return DatasetKind::Kitti; }
-  SensorKind sensor() const override { return sensor_; }
-  std::size_t size() const override { return times_.size(); }
-  double timestamp(std::size_t index) const override { return times_.at(index); }
-  const Trajectory& groundTruth() const override { return groundTruth_; }
-  const fs::path& root() const override { return root_; }
-
-  DatasetCamera camera() const override {
-    if (sensor_ == SensorKind::Monocular) return pinhole_;
-    return RectifiedStereoCamera<double>(pinhole_, baseline_);
-  }
-
-  DatasetFrame frame(std::size_t index) const override {
-    DatasetFrame frame;
-    frame.index = index;
-    frame.timestamp = times_.at(index);
-    frame.left = loadImage(imagePath(0, index), cv::IMREAD_UNCHANGED, timesFile_, index + 1);
-    if (sensor_ == SensorKind::Stereo) {
-      const fs::path right = imagePath(1, index);
-      if (fs::exists(right))
-        frame.right = loadImage(right, cv::IMREAD_UNCHANGED, timesFile_, index + 1);
-      else
-        reportMissing(frame.warnings, false, timesFile_, index + 1,
-                      "right image " + right.string() + " does not exist");
-    }
-    return frame;
-  }
-
- private:
-  fs::path imagePath(int camera, std::size_t index) const {
-    char name[32];
-    std::snprintf(name, sizeof name, "%06zu.png", index);
-    return sequenceDir_ / ("image_" + std::to_string(camera)) / name;
-  }
-
-  fs::path root_, sequenceDir_, timesFile_;
-  DatasetOptions options_;
-  SensorKind sensor_ = SensorKind::Stereo;
-  std::vector<double> times_;
-  PinholeCamera<double> pinhole_;
-  double baseline_ = 0.0;
-  Trajectory groundTruth_;
 };
 
 }  // namespace

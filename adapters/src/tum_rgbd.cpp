@@ -68,20 +68,32 @@ class TumRgbdReader final : public DatasetReader {
       throw Error(root.string(), "", "a TUM RGB-D sequence has no stereo pair (use rgbd or mono)");
     const fs::path rgbList = root / "rgb.txt";
     requireExists(rgbList, "the TUM image list");
-    rgb_ = readImageList(rgbList, root, TimeUnit::Seconds, !options.tolerateBadFrames,
-                         options.tolerateBadFrames ? &warnings_ : nullptr);
+    rgb_ = readImageList(rgbList, root, TimeUnit::Seconds, !options.tolerateBadFrames, warnings_);
     if (sensor_ == SensorKind::Rgbd) {
       const fs::path depthList = root / "depth.txt";
-      requireExists(depthList, "the TUM depth list");
+      if (!fs::exists(depthList)) throw noDepth("there is no depth.txt");
       depth_ = PairedImages(rgb_,
-                            readImageList(depthList, root, TimeUnit::Seconds, false,
-                                          options.tolerateBadFrames ? &warnings_ : nullptr),
+                            readImageList(depthList, root, TimeUnit::Seconds, false, warnings_),
                             options.maxDepthDt, "depth map");
       if (options.strict) depth_.requireAll(rgb_);
+      if (!rgb_.empty() && depth_.pairedOnDisk() == 0) {
+        throw noDepth(depth_.listed() == 0 ? "depth.txt lists no depth map"
+                                           : "none of the " + std::to_string(depth_.listed()) +
+                                                 " depth maps depth.txt lists is on disk within " +
+                                                 std::to_string(options.maxDepthDt) + " s of a colour image");
+      }
     }
     const fs::path gtFile = root / "groundtruth.txt";
-    if (fs::exists(gtFile)) groundTruth_ = readTrajectory(gtFile, TrajectoryFormat::Tum);
+    if (fs::exists(gtFile)) groundTruth_ = readTrajectory(gtFile, TrajectoryFormat::Tum, {}, &warnings_);
     freiburg_ = detectFreiburg(rgbList, root);
+  }
+
+  // A colour-only folder, refused at once rather than skipped frame by frame.
+  Error noDepth(const std::string& why) const {
+    return Error(root_.string(), "",
+                 "no depth maps for the colour images (" + why +
+                     "), so it cannot run as RGB-D; colour alone is monocular (--sensor mono), "
+                     "which orbis does not run yet");
   }
 
   DatasetKind kind() const override { return DatasetKind::TumRgbd; }

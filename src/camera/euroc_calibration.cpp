@@ -1,12 +1,18 @@
 // EuRoC sensor.yaml reader; see orbis/camera/euroc_calibration.hpp.
+//
+// The files ASL publishes are plain YAML starting with a comment; OpenCV's FileStorage refuses
+// them (it wants its own "%YAML:1.0" first line): YamlReader (yaml-cpp) takes them, and the
+// copies that have that line added.
 #include "orbis/camera/euroc_calibration.hpp"
+
+#include <cmath>
 
 #include "yaml_reader.hpp"
 
 namespace orbis {
 
 CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml) {
-  const detail::YamlReader yaml(sensorYaml);
+  const detail::YamlReader yaml(sensorYaml, detail::YamlReader::Header::Optional);
   if (const auto model = yaml.optionalString("camera_model"); model && *model != "pinhole") {
     throw yaml.error("camera_model", "only pinhole is supported, found \"" + *model + "\"");
   }
@@ -17,7 +23,9 @@ CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml) 
   const std::vector<double> d = yaml.reals("distortion_coefficients", 4, 5);
   const std::vector<double> resolution = yaml.reals("resolution", 2, 2);
   if (!(k[0] > 0 && k[1] > 0)) throw yaml.error("intrinsics", "focal lengths fu, fv must be positive");
-  if (!(resolution[0] >= 1 && resolution[1] >= 1)) throw yaml.error("resolution", "expected a positive width and height");
+  if (!(resolution[0] >= 1 && resolution[1] >= 1 && resolution[0] <= 1e5 && resolution[1] <= 1e5 &&
+        resolution[0] == std::floor(resolution[0]) && resolution[1] == std::floor(resolution[1])))
+    throw yaml.error("resolution", "expected a whole positive width and height");
 
   CameraCalibration c;
   c.intrinsics = {k[0], k[1], k[2], k[3], static_cast<int>(resolution[0]), static_cast<int>(resolution[1])};

@@ -1,61 +1,66 @@
-// Checked reads from OpenCV-YAML files; see yaml_reader.hpp.
+// Checked reads from YAML files of keys; see yaml_reader.hpp.
 #include "yaml_reader.hpp"
 
 #include <cmath>
-#include <regex>
+#include <fstream>
+#include <sstream>
 
 namespace orbis::detail {
 
 namespace {
 
-std::string typeName(const cv::FileNode& n) {
-  if (n.isString()) return "the text \"" + static_cast<std::string>(n) + "\"";
-  if (n.isSeq()) return "a sequence";
-  if (n.isMap()) return "a map";
-  if (n.isNone()) return "no value";
-  return "a value of another type";
+std::string typeName(const YAML::Node& n) {
+  if (n.IsSequence()) return "a sequence";
+  if (n.IsMap()) return "a map";
+  if (n.IsNull()) return "no value";
+  return "the text \"" + n.Scalar() + "\"";
 }
 
-// OpenCV reports parse errors as "... in function '<file>(<line>): <problem>'".
-Error parseError(const std::string& path, const cv::Exception& e) {
-  static const std::regex located(R"(\((\d+)\): (.*)')");
-  std::smatch m;
-  if (std::regex_search(e.msg, m, located)) {
-    return lineError(path, std::stoul(m[1].str()), "not valid YAML: " + m[2].str());
-  }
-  return fileError(path, "not an OpenCV YAML file (it must start with %YAML:1.0): " + e.err);
+std::string readText(const std::filesystem::path& path, const std::string& name) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw fileError(name, "no such file");
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in) throw fileError(name, "cannot be opened for reading");
+  return text.str();
 }
 
 }  // namespace
 
-YamlReader::YamlReader(const std::filesystem::path& path) : path_(path.string()) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path_, "no such file");
-  if (std::filesystem::file_size(path, ec) == 0) throw fileError(path_, "empty file, expected OpenCV YAML (%YAML:1.0)");
+YamlReader::YamlReader(const std::filesystem::path& path, Header header) : path_(path.string()) {
+  std::string text = readText(path, path_);
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw fileError(path_, "empty file, expected YAML");
+  // OpenCV's "%YAML:1.0" is not a YAML 1.x directive: made a comment, so line numbers stay.
+  const bool openCvHeader = text.rfind("%YAML:", 0) == 0;
+  if (openCvHeader) text[0] = '#';
+  if (!openCvHeader && header == Header::Required)
+    throw fileError(path_, "not an OpenCV YAML file (it must start with %YAML:1.0, as ORB-SLAM2's settings do)");
   try {
-    if (!storage_.open(path_, cv::FileStorage::READ)) throw fileError(path_, "cannot be opened for reading");
-  } catch (const cv::Exception& e) {
-    throw parseError(path_, e);
+    root_ = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw lineError(path_, static_cast<std::size_t>(e.mark.line) + 1, "not valid YAML: " + e.msg);
   }
-  if (!storage_.root().isMap()) throw fileError(path_, "expected a YAML map of keys at the top level");
+  if (!root_.IsMap()) throw fileError(path_, "expected a YAML map of keys at the top level");
 }
 
-bool YamlReader::has(const std::string& key) const { return !storage_[key].empty(); }
+bool YamlReader::has(const std::string& key) const { return static_cast<bool>(root_[key]); }
 
-cv::FileNode YamlReader::node(const std::string& key) const {
-  cv::FileNode n = storage_[key];
-  if (n.empty()) throw error(key, "missing");
+YAML::Node YamlReader::node(const std::string& key) const {
+  const YAML::Node n = root_[key];
+  if (!n) throw error(key, "missing");
   return n;
 }
 
-double YamlReader::number(const cv::FileNode& n, const std::string& key) const {
-  if (!n.isInt() && !n.isReal()) throw error(key, "expected a number, found " + typeName(n));
-  const double value = static_cast<double>(n);
+double YamlReader::number(const YAML::Node& n, const std::string& key) const {
+  double value = 0.0;
+  if (!n.IsScalar() || !YAML::convert<double>::decode(n, value))
+    throw error(key, "expected a number, found " + typeName(n));
   if (!std::isfinite(value)) throw error(key, "expected a finite number");
   return value;
 }
 
-int YamlReader::wholeNumber(const cv::FileNode& n, const std::string& key) const {
+int YamlReader::wholeNumber(const YAML::Node& n, const std::string& key) const {
   const double value = number(n, key);
   if (value != std::floor(value) || std::abs(value) > 2e9) throw error(key, "expected a whole number");
   return static_cast<int>(value);
@@ -76,9 +81,9 @@ std::optional<int> YamlReader::optionalInteger(const std::string& key) const {
 }
 
 std::string YamlReader::string(const std::string& key) const {
-  const cv::FileNode n = node(key);
-  if (!n.isString()) throw error(key, "expected text, found " + typeName(n));
-  return static_cast<std::string>(n);
+  const YAML::Node n = node(key);
+  if (!n.IsScalar()) throw error(key, "expected text, found " + typeName(n));
+  return n.Scalar();
 }
 
 std::optional<std::string> YamlReader::optionalString(const std::string& key) const {
@@ -87,33 +92,33 @@ std::optional<std::string> YamlReader::optionalString(const std::string& key) co
 }
 
 std::vector<double> YamlReader::reals(const std::string& key, std::size_t minCount, std::size_t maxCount) const {
-  const cv::FileNode n = node(key);
-  if (!n.isSeq()) throw error(key, "expected a sequence of numbers, found " + typeName(n));
-  std::vector<double> values;
-  for (const cv::FileNode& item : n) values.push_back(number(item, key));
-  if (values.size() < minCount || values.size() > maxCount) {
+  const YAML::Node n = node(key);
+  if (!n.IsSequence()) throw error(key, "expected a sequence of numbers, found " + typeName(n));
+  if (n.size() < minCount || n.size() > maxCount) {
     throw error(key, "expected " + std::to_string(minCount) +
                          (maxCount != minCount ? " to " + std::to_string(maxCount) : "") + " numbers, found " +
-                         std::to_string(values.size()));
+                         std::to_string(n.size()));
   }
+  std::vector<double> values;
+  for (const YAML::Node& item : n) values.push_back(number(item, key));
   return values;
 }
 
 Eigen::MatrixXd YamlReader::matrix(const std::string& key) const {
-  const cv::FileNode n = node(key);
-  if (!n.isMap() || n["rows"].empty() || n["cols"].empty() || n["data"].empty()) {
+  const YAML::Node n = node(key);
+  if (!n.IsMap() || !n["rows"] || !n["cols"] || !n["data"]) {
     throw error(key, "expected a matrix (a map with rows, cols and data), found " + typeName(n));
   }
   const int rows = wholeNumber(n["rows"], key + ".rows");
   const int cols = wholeNumber(n["cols"], key + ".cols");
   if (rows <= 0 || cols <= 0 || rows > 64 || cols > 64) throw error(key, "expected 1 to 64 rows and columns");
-  const cv::FileNode data = n["data"];
-  if (!data.isSeq() || static_cast<int>(data.size()) != rows * cols) {
+  const YAML::Node data = n["data"];
+  if (!data.IsSequence() || data.size() != static_cast<std::size_t>(rows * cols)) {
     throw error(key + ".data", "expected " + std::to_string(rows * cols) + " numbers (rows x cols)");
   }
   Eigen::MatrixXd m(rows, cols);
   int i = 0;
-  for (const cv::FileNode& item : data) {
+  for (const YAML::Node& item : data) {
     m(i / cols, i % cols) = number(item, key + ".data");
     ++i;
   }

@@ -1,9 +1,12 @@
-// src/camera/yaml_reader.hpp (internal) — checked reads from an OpenCV-YAML file.
+// src/camera/yaml_reader.hpp (internal) — checked reads from a YAML file of keys.
 //
-// Contract: YamlReader opens a file written in OpenCV's FileStorage YAML dialect (the format
-// of ORB-SLAM2 settings and EuRoC sensor.yaml, starting with %YAML:1.0) and returns values by
-// key. Every failure — missing file, unparseable text, missing key, wrong type, wrong length —
-// throws orbis::Error naming the file and the key (or the line, for parse errors).
+// Contract: YamlReader parses a YAML file with yaml-cpp — ORB-SLAM2 settings (OpenCV's
+// FileStorage dialect: a "%YAML:1.0" first line, !!opencv-matrix maps) and EuRoC sensor.yaml (as
+// published: plain YAML, a comment first) — and returns values by key. OpenCV's own parser is
+// not used: it needs the header and hangs on some damaged files (found by fuzzing). With
+// Header::Required the "%YAML:1.0" line must be there, as ORB-SLAM2 needs it. Every failure —
+// missing file, unparseable text, missing key, wrong type, wrong length — throws orbis::Error
+// naming the file and the key (or the line, for parse errors).
 // Not installed: settings.cpp and the camera readers share it.
 #pragma once
 
@@ -13,7 +16,7 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "orbis/util/error.hpp"
 
@@ -21,7 +24,8 @@ namespace orbis::detail {
 
 class YamlReader {
  public:
-  explicit YamlReader(const std::filesystem::path& path);
+  enum class Header { Required, Optional };  // OpenCV's "%YAML:1.0" first line
+  explicit YamlReader(const std::filesystem::path& path, Header header = Header::Required);
 
   const std::string& path() const { return path_; }
   bool has(const std::string& key) const;
@@ -41,12 +45,12 @@ class YamlReader {
   Eigen::MatrixXd matrix(const std::string& key, int rows, int cols) const;
 
  private:
-  cv::FileNode node(const std::string& key) const;  // throws when missing
-  double number(const cv::FileNode& n, const std::string& key) const;
-  int wholeNumber(const cv::FileNode& n, const std::string& key) const;
+  YAML::Node node(const std::string& key) const;  // throws when missing
+  double number(const YAML::Node& n, const std::string& key) const;
+  int wholeNumber(const YAML::Node& n, const std::string& key) const;
 
   std::string path_;
-  cv::FileStorage storage_;
+  YAML::Node root_;
 };
 
 }  // namespace orbis::detail

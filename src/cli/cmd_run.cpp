@@ -7,15 +7,38 @@
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
+#include "orbis/util/warnings.hpp"
 
 namespace orbis::cli {
 namespace {
 
+// Before the run, so an unwritable --out fails at once rather than after the sequence.
+void createOutputFolder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw Error(dir.string(), "", "cannot create the output folder (" + (ec ? ec.message() : "not a folder") + ")");
+}
+
+// A run that tracked nothing has failed, whatever it wrote: say why, and exit non-zero.
+void requireSomethingTracked(const DatasetReader& dataset, const RunReport& r) {
+  const std::string root = dataset.root().string();
+  if (dataset.size() == 0) throw Error(root, "", "the sequence lists no frame: nothing to run");
+  if (r.stats.frames == 0)
+    throw Error(root, "", "none of the " + std::to_string(dataset.size()) +
+                              " frames could be processed (every one was skipped; the warnings above say why)");
+  if (r.stats.tracked == 0)
+    throw Error(root, "", "none of the " + std::to_string(r.stats.frames) +
+                              " frames processed was tracked: check the camera calibration (--settings FILE), "
+                              "the vocabulary (--vocab) and that the images are not blank");
+}
+
 int runCommand(const std::vector<std::string>& args) {
-  ArgParser p("orbis run tum|euroc|kitti PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
+  ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
               "Runs SLAM over a dataset sequence and writes DIR/trajectory.txt, keyframes.txt, report.json,\n"
-              "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.");
-  p.positional("DATASET", "tum, euroc or kitti (the on-disk layout)")
+              "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.\n"
+              "kitti-raw PATH is a raw drive folder (image_00, image_01, oxts) with the calib_*.txt files beside it.");
+  p.positional("DATASET", "tum, euroc, kitti or kitti-raw (the on-disk layout)")
       .positional("PATH", "the sequence folder")
       .option("--settings", "FILE", "ORB-SLAM2 settings YAML (camera, ORBextractor.*); default: the dataset's calibration")
       .option("--vocab", "FILE", "vocabulary (orbis binary); default: the shipped one")
@@ -40,6 +63,7 @@ int runCommand(const std::vector<std::string>& args) {
   if (auto s = p.getOptional("--settings")) options.settings = *s;
   options.vocabulary = p.has("--vocab") ? std::filesystem::path(p.get("--vocab")) : defaultVocabularyPath();
   options.outDir = p.get("--out");
+  createOutputFolder(options.outDir);
   options.deterministic = p.has("--deterministic");
   options.localisationOnly = p.has("--localize");
   options.loopClosing = !p.has("--no-loop");
@@ -55,6 +79,7 @@ int runCommand(const std::vector<std::string>& args) {
   if (p.has("--json")) {
     std::ifstream in(options.outDir / "report.json");
     std::printf("%s", std::string(std::istreambuf_iterator<char>(in), {}).c_str());
+    requireSomethingTracked(*dataset, r);
     return 0;
   }
   std::printf("dataset        %s (%s)\n", r.dataset.c_str(), r.sensor.c_str());
@@ -71,13 +96,14 @@ int runCommand(const std::vector<std::string>& args) {
   std::printf("\n%-32s %7s %9s %9s %9s\n", "stage", "count", "mean ms", "median", "p95");
   for (const StageStats& s : r.timing)
     std::printf("%-32s %7zu %9.2f %9.2f %9.2f\n", s.stage.c_str(), s.count, s.meanMs, s.medianMs, s.p95Ms);
-  for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const auto& w : readableWarnings(foldWarnings(r.warnings))) std::fprintf(stderr, "warning: %s\n", w.c_str());
   std::printf("\noutputs in %s (trajectory.txt, keyframes.txt, report.json, map.ply, overview.png)\n",
               options.outDir.string().c_str());
+  requireSomethingTracked(*dataset, r);
   return 0;
 }
 
-ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI)", runCommand);
+ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI odometry and raw)", runCommand);
 
 }  // namespace
 }  // namespace orbis::cli

@@ -61,6 +61,7 @@ BalProblem readBal(const std::filesystem::path& file) {
   if (!in) throw fileError(file.string(), "cannot open BAL problem file");
   std::ostringstream buffer;
   buffer << in.rdbuf();
+  const std::size_t bytes = buffer.str().size();
   TokenReader reader(buffer.str(), file.string());
 
   const long numCameras = reader.next<long>("the number of cameras");
@@ -68,6 +69,16 @@ BalProblem readBal(const std::filesystem::path& file) {
   const long numObservations = reader.next<long>("the number of observations");
   if (numCameras <= 0 || numPoints <= 0 || numObservations <= 0) {
     throw lineError(file.string(), 1, "expected positive counts of cameras, points and observations");
+  }
+  // Each number takes at least one byte: counts the file cannot hold are refused before anything
+  // is allocated for them (a short file with plausible counts gets the more precise error below).
+  const auto fits = [&](long count, long numbersEach) { return static_cast<std::size_t>(count) <= bytes / numbersEach; };
+  if (!fits(numObservations, 4) || !fits(numCameras, 9) || !fits(numPoints, 3) ||
+      static_cast<std::size_t>(4 * numObservations + 9 * numCameras + 3 * numPoints) > bytes) {
+    throw lineError(file.string(), 1, "the counts (" + std::to_string(numCameras) + " cameras, " + std::to_string(numPoints) +
+                                          " points, " + std::to_string(numObservations) +
+                                          " observations) need more numbers than the file's " + std::to_string(bytes) +
+                                          " bytes can hold");
   }
   BalProblem problem;
   problem.cameras.resize(numCameras);

@@ -50,6 +50,15 @@ void requireIncreasing(double previous, double current, bool havePrevious,
   }
 }
 
+// A text file opened for reading; a directory opens on Linux but reads as nothing, so say so.
+std::ifstream openText(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw fileError(file.string(), "is a directory, expected a text file");
+  std::ifstream in(file);
+  if (!in) throw fileError(file.string(), "cannot open (missing or unreadable)");
+  return in;
+}
+
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
 };
@@ -64,8 +73,7 @@ FilePtr openForWriting(const std::filesystem::path& file) {
 }  // namespace
 
 void forEachTextRow(const std::filesystem::path& file, const std::function<void(const TextRow&)>& visit) {
-  std::ifstream in(file);
-  if (!in) throw fileError(file.string(), "cannot open (missing or unreadable)");
+  std::ifstream in = openText(file);
   std::string text;
   std::vector<std::string_view> fields;
   std::size_t lineNumber = 0;
@@ -111,18 +119,23 @@ TrajectoryFormat parseTrajectoryFormat(std::string_view name, const std::string&
 std::string_view toString(TrajectoryFormat format) { return enumName(kTrajectoryFormatNames, format); }
 
 TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& file) {
-  if (file.extension() == ".csv") return TrajectoryFormat::Euroc;
-  std::ifstream in(file);
-  if (!in) throw fileError(file.string(), "cannot open (missing or unreadable)");
+  std::ifstream in = openText(file);
   std::string text;
   std::vector<std::string_view> fields;
   while (fields.empty() && std::getline(in, text)) {
     const auto first = text.find_first_not_of(" \t\r");
     if (first != std::string::npos && text[first] != '#') splitFields(text, fields);
   }
+  // EuRoC rows are comma separated and start with integer nanoseconds; TUM rows start with
+  // seconds. Either may come with either extension (evo writes EuRoC ground truth as TUM).
   const std::size_t columns = fields.size();
+  const bool integerTime = columns > 0 && fields[0].find_first_not_of("0123456789") == std::string_view::npos;
+  const bool commas = text.find(',') != std::string::npos;
+  if (columns >= 8 && integerTime && (commas || file.extension() == ".csv")) return TrajectoryFormat::Euroc;
   if (columns == 8) return TrajectoryFormat::Tum;
   if (columns == 12) return TrajectoryFormat::Kitti;
+  if (columns == 0 && file.extension() == ".csv") return TrajectoryFormat::Euroc;
+  if (columns == 0) throw fileError(file.string(), "holds no data row (empty, or comments only)");
   throw fileError(file.string(), "cannot tell the trajectory format (first data row has " +
                                      std::to_string(columns) + " columns; use --format)");
 }
@@ -139,9 +152,62 @@ std::vector<double> readTimestamps(const std::filesystem::path& file) {
   return times;
 }
 
+TimeOrder putInTimeOrder(const std::vector<double>& times, const std::vector<std::size_t>& lines) {
+  TimeOrder order;
+  for (std::size_t i = 1; i < times.size(); ++i) {
+    if (times[i] < times[i - 1] && order.outOfOrder++ == 0) order.firstOutOfOrderLine = lines[i];
+  }
+  std::vector<std::size_t> sorted(times.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) sorted[i] = i;
+  if (order.outOfOrder > 0)
+    std::stable_sort(sorted.begin(), sorted.end(), [&](std::size_t a, std::size_t b) { return times[a] < times[b]; });
+  for (const std::size_t i : sorted) {
+    if (!order.keep.empty() && times[i] == times[order.keep.back()]) {
+      if (order.repeated++ == 0 || lines[i] < order.firstRepeatedLine) order.firstRepeatedLine = lines[i];
+      continue;
+    }
+    order.keep.push_back(i);
+  }
+  return order;
+}
+
+std::vector<std::string> TimeOrder::warnings(const std::filesystem::path& file) const {
+  std::vector<std::string> out;
+  if (outOfOrder > 0)
+    out.push_back(file.string() + ": " + std::to_string(outOfOrder) + " row(s) earlier than the row before " +
+                  "(first at line " + std::to_string(firstOutOfOrderLine) + "); rows sorted by timestamp");
+  if (repeated > 0)
+    out.push_back(file.string() + ": " + std::to_string(repeated) + " row(s) repeat an earlier timestamp " +
+                  "(first at line " + std::to_string(firstRepeatedLine) + "); kept the first of each");
+  return out;
+}
+
+namespace {
+
+// Sorts and de-duplicates a TUM or EuRoC trajectory read with the given line numbers.
+Trajectory inTimeOrder(Trajectory rows, const std::vector<std::size_t>& lines, const std::filesystem::path& file,
+                       std::vector<std::string>* warnings) {
+  std::vector<double> times;
+  times.reserve(rows.size());
+  for (const StampedPose& row : rows) times.push_back(row.t);
+  const TimeOrder order = putInTimeOrder(times, lines);
+  for (const std::string& w : order.warnings(file)) {
+    if (warnings) warnings->push_back(w);
+    else std::fprintf(stderr, "warning: %s\n", w.c_str());
+  }
+  if (order.keep.size() == rows.size() && order.outOfOrder == 0) return rows;
+  Trajectory kept;
+  kept.reserve(order.keep.size());
+  for (const std::size_t i : order.keep) kept.push_back(rows[i]);
+  return kept;
+}
+
+}  // namespace
+
 Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat format,
-                          const std::filesystem::path& kittiTimesFile) {
+                          const std::filesystem::path& kittiTimesFile, std::vector<std::string>* warnings) {
   Trajectory trajectory;
+  std::vector<std::size_t> lines;
   double v[12];
   auto parseAll = [&](const TextRow& row, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) v[i] = parseDouble(row.fields[i], file, row.line);
@@ -153,8 +219,7 @@ Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
           throw lineError(file.string(), row.line,
                           fieldCountMessage(8, row.fields.size(), "TUM: t tx ty tz qx qy qz qw"));
         parseAll(row, 8);
-        requireIncreasing(trajectory.empty() ? 0.0 : trajectory.back().t, v[0], !trajectory.empty(),
-                          file, row.line);
+        lines.push_back(row.line);
         trajectory.push_back(
             {v[0], poseFromQuaternion({v[1], v[2], v[3]}, v[7], v[4], v[5], v[6], file, row.line)});
       });
@@ -167,8 +232,7 @@ Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
                                             "EuRoC: t[ns], px, py, pz, qw, qx, qy, qz, ..."));
         const double t = static_cast<double>(parseInteger(row.fields[0], file, row.line)) * 1e-9;
         for (std::size_t i = 1; i < 8; ++i) v[i] = parseDouble(row.fields[i], file, row.line);
-        requireIncreasing(trajectory.empty() ? 0.0 : trajectory.back().t, t, !trajectory.empty(),
-                          file, row.line);
+        lines.push_back(row.line);
         trajectory.push_back(
             {t, poseFromQuaternion({v[1], v[2], v[3]}, v[4], v[5], v[6], v[7], file, row.line)});
       });
@@ -197,7 +261,8 @@ Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
       break;
     }
   }
-  return trajectory;
+  if (format == TrajectoryFormat::Kitti) return trajectory;
+  return inTimeOrder(std::move(trajectory), lines, file, warnings);
 }
 
 Trajectory posesCovering(const Trajectory& trajectory, const Trajectory& span, double marginSeconds) {

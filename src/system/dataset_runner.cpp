@@ -13,6 +13,7 @@
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
 #include "orbis/util/progress.hpp"
+#include "orbis/util/warnings.hpp"
 
 #ifndef ORBIS_INSTALL_DATADIR
 #define ORBIS_INSTALL_DATADIR ""
@@ -47,7 +48,8 @@ Defaults datasetDefaults(DatasetKind kind) {
   switch (kind) {
     case DatasetKind::TumRgbd: return {1000, 30};
     case DatasetKind::Euroc: return {1200, 20};
-    case DatasetKind::Kitti: return {2000, 10};
+    case DatasetKind::Kitti:
+    case DatasetKind::KittiRaw: return {2000, 10};
   }
   return {1000, 30};
 }
@@ -75,8 +77,13 @@ void writeReport(const fs::path& file, const RunReport& r) {
     w.field("p95", s.p95Ms).field("max", s.maxMs).endObject();
   }
   w.endObject();
+  // Repeated warnings folded (a few of each kind, then a count), as the program prints them.
+  const std::vector<WarningKind> kinds = foldWarnings(r.warnings);
   w.key("warnings").beginArray();
-  for (const auto& m : r.warnings) w.value(m);
+  for (const auto& m : readableWarnings(kinds)) w.value(m);
+  w.endArray();
+  w.key("warning_counts").beginArray();
+  for (const WarningKind& k : kinds) w.beginObject().field("kind", k.pattern).field("count", k.count).endObject();
   w.endArray().endObject();
   std::ofstream out(file);
   if (!out) throw fileError(file.string(), "cannot open for writing");
@@ -134,17 +141,18 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
         report.warnings.push_back(std::string("frame ") + std::to_string(i) + " skipped: " + e.what());
         continue;
       }
-      for (const auto& w : frame.warnings) report.warnings.push_back("frame " + std::to_string(i) + ": " + w);
       if (!(frame.timestamp > lastTimestamp)) {
         report.warnings.push_back("frame " + std::to_string(i) + " skipped: timestamp " +
                                   std::to_string(frame.timestamp) + " does not increase");
         continue;
       }
       const auto input = makeInput<Sensor>(frame);
-      if (!inputComplete(input)) {
-        report.warnings.push_back("frame " + std::to_string(i) + " skipped: incomplete input");
+      if (!inputComplete(input)) {  // one warning per skipped frame: the reader's reason, if it gave one
+        report.warnings.push_back("frame " + std::to_string(i) + " skipped: " +
+                                  (frame.warnings.empty() ? "incomplete input" : frame.warnings.front()));
         continue;
       }
+      for (const auto& w : frame.warnings) report.warnings.push_back("frame " + std::to_string(i) + ": " + w);
       lastTimestamp = frame.timestamp;
       const TrackResult r = slam.track(input);
       if constexpr (Sensor::kDepthFromSensor) {

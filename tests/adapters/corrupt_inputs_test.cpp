@@ -110,8 +110,6 @@ TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {
   makeTum();
   writeText("rgb.txt", "# c\n100.0 rgb/100.000000.png\n100.1 rgb/100.100000.png extra\n");
   expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 3");
-  writeText("rgb.txt", "100.1 rgb/100.100000.png\n100.0 rgb/100.000000.png\n");
-  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 2");
   writeText("rgb.txt", "100.0 rgb/100.000000.png\nabc rgb/100.100000.png\n");
   expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 2");
   writeText("rgb.txt", "100.0 rgb/100.000000.png\n100.5 rgb/nothere.png\n");
@@ -122,20 +120,54 @@ TEST_F(CorruptInputs, TumMalformedOutOfOrderAndMissingNameFileAndLine) {
 
 TEST_F(CorruptInputs, TolerantReadingTurnsBadRowsIntoFrameErrorsAndWarnings) {
   makeTum();
-  // Row 4 repeats row 3's timestamp; row 5 names an image that is not there.
+  // Row 4 repeats row 3's timestamp (kept: row 3, as evo keeps the first); row 5 names an image
+  // that is not there.
   writeText("rgb.txt",
             "# c\n# f\n100.000000 rgb/100.000000.png\n100.000000 rgb/100.100000.png\n"
             "100.100000 rgb/gone.png\n100.200000 rgb/100.200000.png\n");
-  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 4");
+  expectError([&] { orbis::openTumRgbd(root_, {}); }, "rgb.txt", "line 5");
   orbis::DatasetOptions tolerant;
   tolerant.tolerateBadFrames = true;
   const auto reader = orbis::openTumRgbd(root_, tolerant);
   ASSERT_EQ(reader->size(), 3u);
   ASSERT_EQ(reader->warnings().size(), 1u);
-  EXPECT_NE(reader->warnings()[0].find("rgb.txt, line 4"), std::string::npos) << reader->warnings()[0];
+  EXPECT_NE(reader->warnings()[0].find("rgb.txt: 1 row(s) repeat an earlier timestamp (first at line 4)"),
+            std::string::npos)
+      << reader->warnings()[0];
   EXPECT_NO_THROW(reader->frame(0));
   expectError([&] { reader->frame(1); }, "rgb.txt", "line 5");
   EXPECT_NO_THROW(reader->frame(2));
+}
+
+// Lists as published may come out of order: sorted, with one warning naming the first such row.
+TEST_F(CorruptInputs, TumListOutOfOrderIsSorted) {
+  makeTum();
+  writeText("rgb.txt", "100.100000 rgb/100.100000.png\n100.000000 rgb/100.000000.png\n");
+  const auto reader = orbis::openTumRgbd(root_, {});
+  ASSERT_EQ(reader->size(), 2u);
+  EXPECT_LT(reader->timestamp(0), reader->timestamp(1));
+  ASSERT_EQ(reader->warnings().size(), 1u);
+  EXPECT_NE(reader->warnings()[0].find("(first at line 2); rows sorted"), std::string::npos) << reader->warnings()[0];
+}
+
+// An rgb-only folder is refused when opened, saying so, not skipped frame by frame.
+TEST_F(CorruptInputs, TumWithoutDepthIsRefusedAtOnce) {
+  makeTum();
+  for (const std::string& depthList : {std::string("# depth\n"), std::string("100.5 depth/none.png\n"), std::string()}) {
+    if (depthList.empty()) fs::remove(root_ / "depth.txt");
+    else writeText("depth.txt", depthList);
+    try {
+      orbis::openTumRgbd(root_, {});
+      ADD_FAILURE() << "no error for depth.txt '" << depthList << "'";
+    } catch (const orbis::Error& e) {
+      EXPECT_EQ(fs::path(e.source()), root_);
+      EXPECT_NE(std::string(e.what()).find("no depth maps"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--sensor mono"), std::string::npos) << e.what();
+    }
+    orbis::DatasetOptions mono;
+    mono.sensor = orbis::SensorKind::Monocular;
+    EXPECT_EQ(orbis::openTumRgbd(root_, mono)->size(), 3u);
+  }
 }
 
 TEST_F(CorruptInputs, TumGroundTruthErrorsNameTheLine) {
@@ -197,6 +229,24 @@ TEST_F(CorruptInputs, KittiErrorsNameFileAndLineOrKey) {
   expectError([&] { orbis::openKitti(root_, {}); }, "sequences/00/times.txt", "");
 }
 
+// calib.txt as the odometry benchmark ships it: P0-P3 and the velodyne's Tr; times in e-notation.
+TEST_F(CorruptInputs, KittiFullOdometryCalibrationIsRead) {
+  makeKitti();
+  writeText("sequences/00/calib.txt",
+            "P0: 7.188560e+02 0 6.071928e+02 0 0 7.188560e+02 1.852157e+02 0 0 0 1 0\n"
+            "P1: 7.188560e+02 0 6.071928e+02 -3.861448e+02 0 7.188560e+02 1.852157e+02 0 0 0 1 0\n"
+            "P2: 7.188560e+02 0 6.071928e+02 4.538225e+01 0 7.188560e+02 1.852157e+02 -1.130887e-01 0 0 1 3.779761e-03\n"
+            "P3: 7.188560e+02 0 6.071928e+02 -3.372877e+02 0 7.188560e+02 1.852157e+02 2.369057e+00 0 0 1 4.915215e-03\n"
+            "Tr: 4.276802e-04 -9.999672e-01 -8.084491e-03 -1.198459e-02 -7.210626e-03 8.081198e-03 "
+            "-9.999413e-01 -5.403984e-02 9.999738e-01 4.859485e-04 -7.206933e-03 -2.921968e-01\n");
+  writeText("sequences/00/times.txt", "0.000000e+00\n1.036223e-01\n");
+  const auto reader = orbis::openKitti(root_, {});
+  const auto camera = std::get<orbis::RectifiedStereoCamera<double>>(reader->camera());
+  EXPECT_DOUBLE_EQ(camera.pinhole.fx, 718.856);
+  EXPECT_NEAR(camera.bf(), 386.1448, 1e-9);
+  EXPECT_DOUBLE_EQ(reader->timestamp(1), 0.1036223);
+}
+
 TEST_F(CorruptInputs, KittiMissingRightImageIsReported) {
   makeKitti();
   fs::remove(root_ / "sequences/00/image_1/000001.png");
@@ -211,7 +261,7 @@ TEST_F(CorruptInputs, KittiMissingRightImageIsReported) {
 }
 
 TEST_F(CorruptInputs, EurocErrorsNameFileAndLine) {
-  writeText("mav0/cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png\n900000000,b.png\n");
+  writeText("mav0/cam0/data.csv", "#timestamp [ns],filename\n1000000000,a.png\nten,b.png\n");
   writeImage("mav0/cam0/data/a.png", CV_8UC1);
   writeImage("mav0/cam0/data/b.png", CV_8UC1);
   expectError([&] { orbis::openEuroc(root_, {}); }, "mav0/cam0/data.csv", "line 3");

@@ -187,10 +187,14 @@ TEST_F(MalformedSettings, TruncatedOrNotYaml) {
   // Cut at a line end: still YAML, so the first key that went missing is named.
   const auto cut = tum1_.find("Camera.k1");
   expectKeyError("truncated_at_line.yaml", tum1_.substr(0, cut), "Camera.k1");
-  // Cut inside a key: OpenCV's parser fails, and the error names the line.
+  // Cut inside a key: the dangling word is no key, so the key it was is named missing.
   const auto mid = tum1_.find("Camera.k2") + 6;
-  const auto line = std::count(tum1_.begin(), tum1_.begin() + static_cast<std::ptrdiff_t>(mid), '\n') + 1;
-  expectFileError("truncated_mid_key.yaml", tum1_.substr(0, mid), "line " + std::to_string(line));
+  expectKeyError("truncated_mid_key.yaml", tum1_.substr(0, mid), "Camera.k2");
+  // Text that is no YAML: the parser's error names the line.
+  const auto fx = tum1_.find("Camera.fx");
+  const auto line = std::count(tum1_.begin(), tum1_.begin() + static_cast<std::ptrdiff_t>(fx), '\n') + 1;
+  expectFileError("unquoted_colon.yaml", replaced(tum1_, "Camera.fx: 517.306408", "Camera.fx: [517.306408: ]]"),
+                  "line " + std::to_string(line));
   expectFileError("not_yaml.yaml", "\x89PNG\r\n\x1a\n binary image data", "");
   expectFileError("no_header.yaml", "Camera.fx: 500\nCamera.fy: 500\n", "");
   expectFileError("empty.yaml", "", "");

@@ -111,11 +111,62 @@ TEST_F(TrajectoryIoTest, MalformedLinesNameFileAndLine) {
   expectLineError(write("word.txt", "1 0 0 0 0 0 0 1\n\n2 0 zero 0 0 0 0 1\n"), TrajectoryFormat::Tum, 3);
   expectLineError(write("nan.txt", "1 0 0 nan 0 0 0 1\n"), TrajectoryFormat::Tum, 1);
   expectLineError(write("zeroq.txt", "1 0 0 0 0 0 0 0\n"), TrajectoryFormat::Tum, 1);
-  expectLineError(write("order.txt", "2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n"), TrajectoryFormat::Tum, 2);
   expectLineError(write("bad.csv", "#h\n100,1,2,3,1,0,0,0\n200,1,2,3,1,0,0\n"), TrajectoryFormat::Euroc, 3);
   expectLineError(write("float.csv", "1.5e9,1,2,3,1,0,0,0\n"), TrajectoryFormat::Euroc, 1);
   expectLineError(write("k.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n"), TrajectoryFormat::Kitti, 2);
   expectLineError(write("notrot.txt", "2 0 0 0 0 2 0 0 0 0 2 0\n"), TrajectoryFormat::Kitti, 1);
+}
+
+// TUM fr2/desk's ground truth repeats a timestamp (line 10,863): the first row is kept and the
+// repair is one warning with its count, as evo does; rows out of order are sorted.
+TEST_F(TrajectoryIoTest, RepeatedTimestampsKeepTheFirstAndOutOfOrderRowsAreSorted) {
+  const fs::path gt = write("groundtruth.txt",
+                            "# ground truth trajectory\n# timestamp tx ty tz qx qy qz qw\n"
+                            "1311868164.3633 1 0 0 0 0 0 1\n"
+                            "1311868164.3733 2 0 0 0 0 0 1\n"
+                            "1311868164.3733 9 0 0 0 0 0 1\n"
+                            "1311868164.3733 9 0 0 0 0 0 1\n"
+                            "1311868164.3833 3 0 0 0 0 0 1\n");
+  std::vector<std::string> warnings;
+  const Trajectory traj = orbis::readTrajectory(gt, TrajectoryFormat::Tum, {}, &warnings);
+  ASSERT_EQ(traj.size(), 3u);
+  EXPECT_EQ(traj[1].pose.translation().x(), 2.0);  // the first of the repeats
+  EXPECT_EQ(traj[2].pose.translation().x(), 3.0);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find(gt.string() + ": 2 row(s) repeat"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("line 5"), std::string::npos) << warnings[0];
+
+  const fs::path shuffled = write("order.csv", "#h\n300,3,0,0,1,0,0,0\n100,1,0,0,1,0,0,0\n200,2,0,0,1,0,0,0\n"
+                                               "100,7,0,0,1,0,0,0\n");
+  warnings.clear();
+  const Trajectory sorted = orbis::readTrajectory(shuffled, TrajectoryFormat::Euroc, {}, &warnings);
+  ASSERT_EQ(sorted.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(sorted[i].pose.translation().x(), static_cast<double>(i + 1));
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("2 row(s) earlier than the row before (first at line 3)"), std::string::npos)
+      << warnings[0];
+  EXPECT_NE(warnings[1].find("1 row(s) repeat an earlier timestamp (first at line 5)"), std::string::npos)
+      << warnings[1];
+}
+
+TEST(TimeOrder, SortsStablyAndDropsLaterRepeats) {
+  const orbis::TimeOrder order = orbis::putInTimeOrder({1.0, 3.0, 2.0, 3.0, 1.0}, {10, 11, 12, 13, 14});
+  EXPECT_EQ(order.keep, (std::vector<std::size_t>{0, 2, 1}));
+  EXPECT_EQ(order.repeated, 2u);
+  EXPECT_EQ(order.firstRepeatedLine, 13u);
+  EXPECT_EQ(order.outOfOrder, 2u);
+  EXPECT_EQ(order.firstOutOfOrderLine, 12u);
+  EXPECT_TRUE(orbis::putInTimeOrder({1.0, 2.0}, {1, 2}).warnings("f").empty());
+}
+
+TEST_F(TrajectoryIoTest, DetectsEurocAndTumFormsWhateverTheExtension) {
+  EXPECT_EQ(orbis::detectTrajectoryFormat(write("gt.txt", "#h\n1403715273262142976,1,2,3,1,0,0,0,9,9\n")),
+            TrajectoryFormat::Euroc);
+  EXPECT_EQ(orbis::detectTrajectoryFormat(write("gt.csv", "# t x\n1403715274.30214 0 0 0 0 0 0 1\n")),
+            TrajectoryFormat::Tum);
+  EXPECT_EQ(orbis::detectTrajectoryFormat(write("data.tum", "1403715274.30214 0 0 0 0 0 0 1\n")),
+            TrajectoryFormat::Tum);
+  EXPECT_THROW(orbis::detectTrajectoryFormat(write("odd.txt", "1 2 3\n")), orbis::Error);
 }
 
 TEST_F(TrajectoryIoTest, MissingFilesAndMismatchedTimesAreErrors) {

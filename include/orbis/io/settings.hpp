@@ -1,4 +1,4 @@
-// orbis/io/settings.hpp — ORB-SLAM2 settings files (YAML, read with cv::FileStorage).
+// orbis/io/settings.hpp — ORB-SLAM2 settings files (OpenCV-dialect YAML, read with yaml-cpp).
 //
 // Contract: Settings::load() reads an ORB-SLAM2 settings file unchanged (it starts with
 // %YAML:1.0): Camera.fx/fy/cx/cy/k1/k2/p1/p2[/k3/width/height/fps/RGB/bf], ThDepth,

@@ -8,9 +8,12 @@
 //          times file (one number per line, same count) or are the frame index 0,1,2,...;
 //   EuRoC  csv "t_ns, px, py, pz, qw, qx, qy, qz[, ignored columns...]", '#' header.
 // Quaternions are normalised on reading, rotation matrices re-orthonormalised. A malformed
-// line, a non-finite number, a zero quaternion or a timestamp not strictly after the previous
-// one throws orbis::Error naming the file and the line. Writers throw orbis::Error naming the
-// path when it cannot be written. Timestamps are doubles: EuRoC nanoseconds survive a round
+// line, a non-finite number or a zero quaternion throws orbis::Error naming the file and the
+// line. Published files repeat timestamps (TUM fr2/desk's ground truth) or list rows out of
+// order: TUM and EuRoC rows are sorted by time and, of rows with equal timestamps, the first is
+// kept, as evo does; each kind of repair is one warning with its count (put in `warnings`, or
+// printed on stderr when none is given). KITTI times files must increase strictly (a row is a
+// frame index). Writers throw orbis::Error naming the path when it cannot be written. Timestamps are doubles: EuRoC nanoseconds survive a round
 // trip to within ~0.3 microseconds at present-day epochs.
 #pragma once
 
@@ -39,13 +42,14 @@ enum class TrajectoryFormat { Tum, Kitti, Euroc };
 TrajectoryFormat parseTrajectoryFormat(std::string_view name, const std::string& source = "format");
 std::string_view toString(TrajectoryFormat format);
 
-// Guesses from the extension (.csv → EuRoC) and else from the first data row's column count
-// (8 → TUM, 12 → KITTI). Throws orbis::Error naming the file when it cannot tell.
+// Guesses from the first data row: comma-separated (or in a .csv) with integer nanoseconds first
+// → EuRoC, else 8 columns → TUM, 12 → KITTI. Throws orbis::Error naming the file when it cannot tell.
 TrajectoryFormat detectTrajectoryFormat(const std::filesystem::path& file);
 
 // kittiTimesFile is used only for TrajectoryFormat::Kitti; empty means "frame index".
 Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat format,
-                          const std::filesystem::path& kittiTimesFile = {});
+                          const std::filesystem::path& kittiTimesFile = {},
+                          std::vector<std::string>* warnings = nullptr);
 // Reads a KITTI times.txt-style file: one timestamp per line, strictly increasing.
 std::vector<double> readTimestamps(const std::filesystem::path& file);
 
@@ -63,6 +67,19 @@ std::vector<std::pair<std::size_t, std::size_t>> associateTimestamps(const std::
 // `marginSeconds` (all of them when `span` is empty): the ground truth an estimate covers, so a
 // short run drawn over a whole sequence's ground truth is not a speck in the view.
 Trajectory posesCovering(const Trajectory& trajectory, const Trajectory& span, double marginSeconds);
+
+// Rows of a time-stamped file put in time order: `keep` holds the indices of the rows to keep,
+// sorted by time (stable, so of equal timestamps the first in the file comes first) with every
+// row whose timestamp equals the one kept before it dropped.
+struct TimeOrder {
+  std::vector<std::size_t> keep;
+  std::size_t repeated = 0, outOfOrder = 0;                  // rows dropped / rows earlier than their predecessor
+  std::size_t firstRepeatedLine = 0, firstOutOfOrderLine = 0;  // 1-based lines, 0 when none
+  // One warning per kind of repair, naming the file, the count and the first line.
+  std::vector<std::string> warnings(const std::filesystem::path& file) const;
+};
+// times[i] was read from line lines[i].
+TimeOrder putInTimeOrder(const std::vector<double>& times, const std::vector<std::size_t>& lines);
 
 // ---- Text tables, shared with the dataset adapters ------------------------------------------
 // One data row of a text table: its 1-based line number and its fields (split on whitespace

@@ -4,8 +4,10 @@
 // Contract: openDataset reads only the small text files (lists, timestamps, calibration,
 // ground truth) and checks them; images are loaded when a frame is asked for, so a whole
 // sequence is never held in memory. Frames come in time order; frame(i) may be called in any
-// order. A missing file, an unreadable image, a malformed line or timestamps out of order
-// throw orbis::Error naming the file (and the line, for text files). A missing right image or
+// order. A missing file, an unreadable image or a malformed line throws orbis::Error naming
+// the file (and the line, for text files). Lists and ground truth whose rows are out of time
+// order are sorted, and of rows with equal timestamps the first is kept, each kind of repair
+// one entry in DatasetReader::warnings() with its count. A missing right image or
 // depth map is reported on the frame (DatasetFrame::warnings) or, with DatasetOptions::strict,
 // thrown; it is never skipped silently. Ground truth is given as camera-to-world poses of the
 // left (or colour) camera — for EuRoC, of the rectified left camera when rectifying.
@@ -29,14 +31,15 @@
 
 namespace orbis {
 
-enum class DatasetKind { TumRgbd, Euroc, Kitti };
+enum class DatasetKind { TumRgbd, Euroc, Kitti, KittiRaw };
 // SensorKind, parseSensorKind and toString(SensorKind): orbis/camera/sensor_kind.hpp (shared with
 // the settings reader).
 
-// "tum", "euroc", "kitti"; throws orbis::Error(source) otherwise.
+// "tum", "euroc", "kitti", "kitti-raw"; throws orbis::Error(source) otherwise.
 DatasetKind parseDatasetKind(std::string_view name, const std::string& source = "dataset kind");
 std::string_view toString(DatasetKind kind);
-// Recognises a dataset folder by its files (rgb.txt; mav0/; sequences/ or times.txt).
+// Recognises a dataset folder by its files (rgb.txt; mav0/; sequences/ or times.txt;
+// image_00/timestamps.txt for a KITTI raw drive).
 std::optional<DatasetKind> detectDatasetKind(const std::filesystem::path& root);
 
 struct DatasetOptions {
@@ -56,8 +59,8 @@ struct DatasetOptions {
   bool rectify = true;        // EuRoC: deliver rectified images and calibration (what the pipeline eats)
   bool strict = false;        // a missing right image or depth map throws instead of warning
   // A long run should survive a bad frame: a listed left/colour image that does not exist is then
-  // an error of that frame only (frame(i) throws, naming list file and line), and a list row whose
-  // timestamp does not increase is dropped with a warning (DatasetReader::warnings()).
+  // an error of that frame only (frame(i) throws, naming list file and line) instead of an error
+  // when opening.
   bool tolerateBadFrames = false;
   std::string kittiSequence;  // KITTI: "06" when root holds several sequences
 };
@@ -92,7 +95,7 @@ class DatasetReader {
   // or undistorted already): TUM freiburg1/2 images are distorted.
   virtual RadTanDistortion<double> distortion() const { return {}; }
   virtual const std::filesystem::path& root() const = 0;
-  // What was found wrong, and survived, while opening (DatasetOptions::tolerateBadFrames).
+  // What was found wrong, and survived, while opening (rows put in time order, ...).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
   // Sequential reading: the next frame, or nothing past the end.
@@ -116,5 +119,9 @@ std::unique_ptr<DatasetReader> openDataset(DatasetKind kind, const std::filesyst
 std::unique_ptr<DatasetReader> openTumRgbd(const std::filesystem::path& root, const DatasetOptions& options);
 std::unique_ptr<DatasetReader> openEuroc(const std::filesystem::path& root, const DatasetOptions& options);
 std::unique_ptr<DatasetReader> openKitti(const std::filesystem::path& root, const DatasetOptions& options);
+// A KITTI raw drive folder (2011_09_26_drive_0001_sync: image_00/, image_01/, oxts/) with the
+// calib_*.txt files beside it (the date folder) or in it. Ground truth: the OXTS poses as
+// rectified left-camera poses, the first camera being the world.
+std::unique_ptr<DatasetReader> openKittiRaw(const std::filesystem::path& root, const DatasetOptions& options);
 
 }  // namespace orbis
