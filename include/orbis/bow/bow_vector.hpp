@@ -4,7 +4,8 @@
 // Vocabulary::transform the weights are positive and sum to 1 (L1-normalised), so l1Score of
 // two such vectors lies in [0, 1]: 1 for identical vectors, 0 when they share no word.
 // FeatureVector groups feature indices by the vocabulary node a few levels above the leaves,
-// in compressed rows: nodes sorted ascending, each with its feature indices in ascending order.
+// in compressed rows: nodes sorted ascending, each with its feature indices in ascending order;
+// forEachSharedNode walks the nodes two of them share (the candidate groups of guided matching).
 #pragma once
 
 #include <algorithm>
@@ -142,5 +143,17 @@ class FeatureVector {
   std::vector<std::uint32_t> offsets_;  // size() + 1 entries when non-empty
   std::vector<std::uint32_t> features_;
 };
+
+// Calls visit(featuresOfA, featuresOfB) for every vocabulary node that both feature vectors
+// hold, in node order: the candidate groups of ORB-SLAM's bag-of-words guided matching.
+template <class Visit>
+void forEachSharedNode(const FeatureVector& a, const FeatureVector& b, Visit&& visit) {
+  std::size_t ia = 0, ib = 0;
+  while (ia < a.size() && ib < b.size()) {
+    if (a.node(ia) < b.node(ib)) ++ia;
+    else if (b.node(ib) < a.node(ia)) ++ib;
+    else visit(a.featuresOf(ia++), b.featuresOf(ib++));
+  }
+}
 
 }  // namespace orbis::bow

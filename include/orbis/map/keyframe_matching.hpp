@@ -5,7 +5,8 @@
 // and map points or another keyframe, writes its matches into one slot per keypoint of the
 // first keyframe (null when unmatched) and returns how many slots it filled. Callers hold
 // Map::mutex(). Candidates are visited in index order and ties keep the first, so results are
-// deterministic.
+// deterministic. Like map_matching.hpp's, these are adapters over the kernels of
+// features/matcher.hpp (nearestTwo, RotationHistogram).
 //  - matchKeyFramesByBow: keyframe-to-keyframe, both keypoints owning map points, candidates
 //    grouped by vocabulary node, best distance ≤ TH_LOW and < ratio × second best, rotation
 //    consistency.

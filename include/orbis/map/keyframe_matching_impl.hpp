@@ -42,18 +42,9 @@ inline long bestInArea(const KeyFrame& kf, float u, float v, int level, float ra
                 int maxDistance, const std::vector<MapPoint*>* taken) {
   const FrameFeatures& f = kf.features();
   const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
-  int bestDist = 256;
-  long best = -1;
-  for (int j : f.grid.featuresInArea(u, v, r, level - 1, level + 1)) {
-    const auto sj = static_cast<std::size_t>(j);
-    if (taken && (*taken)[sj]) continue;
-    const int d = hammingDistance(descriptor, f.descriptors[sj]);
-    if (d < bestDist) {
-      bestDist = d;
-      best = j;
-    }
-  }
-  return bestDist <= maxDistance ? best : -1;
+  const NearestTwo n = nearestTwo(f, descriptor, f.grid.featuresInArea(u, v, r, level - 1, level + 1),
+                                  [&](std::size_t j) { return taken && (*taken)[j]; });
+  return n.best >= 0 && n.bestDistance <= maxDistance ? n.best : -1;
 }
 
 }  // namespace keyframe_detail
@@ -64,36 +55,24 @@ inline int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::ve
   matches12.assign(kf1.size(), nullptr);
   std::vector<char> taken2(kf2.size(), 0);
   RotationHistogram hist;
-  const auto& a = kf1.featureVector();
-  const auto& b = kf2.featureVector();
   int matches = 0;
-  std::size_t ia = 0, ib = 0;
-  while (ia < a.size() && ib < b.size()) {
-    if (a.node(ia) < b.node(ib)) { ++ia; continue; }
-    if (b.node(ib) < a.node(ia)) { ++ib; continue; }
-    for (std::uint32_t i : a.featuresOf(ia)) {
+  bow::forEachSharedNode(kf1.featureVector(), kf2.featureVector(), [&](auto features1, auto features2) {
+    for (std::uint32_t i : features1) {
       MapPoint* p1 = kf1.point(i);
       if (!p1 || p1->isBad()) continue;
-      int bestDist = 256, secondDist = 256;
-      long best = -1;
-      for (std::uint32_t j : b.featuresOf(ib)) {
-        MapPoint* p2 = kf2.point(j);
-        if (taken2[j] || !p2 || p2->isBad()) continue;
-        const int d = hammingDistance(f1.descriptors[i], f2.descriptors[j]);
-        if (d < bestDist) { secondDist = bestDist; bestDist = d; best = j; }
-        else if (d < secondDist) secondDist = d;
-      }
-      if (best >= 0 && bestDist < kThLow && bestDist < ratio * static_cast<float>(secondDist)) {
-        const auto j = static_cast<std::size_t>(best);
+      const NearestTwo n = nearestTwo(f2, f1.descriptors[i], features2, [&](std::size_t j) {
+        const MapPoint* p2 = kf2.point(j);
+        return taken2[j] || !p2 || p2->isBad();
+      });
+      if (n.best >= 0 && n.bestDistance < kThLow && n.bestDistance < ratio * static_cast<float>(n.secondDistance)) {
+        const auto j = static_cast<std::size_t>(n.best);
         matches12[i] = kf2.point(j);
         taken2[j] = 1;
         hist.add(f1.keypointsUn[i].angle - f2.keypointsUn[j].angle, static_cast<int>(i));
         ++matches;
       }
     }
-    ++ia;
-    ++ib;
-  }
+  });
   matches -= hist.clearRejected(matches12);
   return matches;
 }

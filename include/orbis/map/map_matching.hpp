@@ -5,10 +5,13 @@
 // stereo coordinate uR is checked only for a StereoCameraModel): each projects or groups
 // candidates, compares 256-bit descriptors by Hamming distance under the named thresholds, and
 // (where asked) keeps only matches whose orientation change agrees with the dominant ones
-// (rotation histogram). Callers hold Map::mutex(). Results are deterministic: candidates are
-// visited in index/id order and ties keep the first. Bodies: map_matching_impl.hpp, compiled
-// where the pipeline is instantiated. Loop closing's keyframe-to-keyframe searches are in
-// keyframe_matching.hpp, beside these, below every thread module.
+// (rotation histogram). Each is an adapter from map objects to the kernels of
+// features/matcher.hpp (nearestTwo over a grid window or a shared vocabulary node,
+// bestEpipolarPartner, RotationHistogram); matchLocalPoints runs its searchByProjection.
+// Callers hold Map::mutex(). Results are deterministic: candidates are visited in index/id order
+// and ties keep the first. Bodies: map_matching_impl.hpp, compiled where the pipeline is
+// instantiated. Loop closing's keyframe-to-keyframe searches are in keyframe_matching.hpp,
+// beside these, below every thread module.
 #pragma once
 
 #include <set>
@@ -17,7 +20,7 @@
 
 #include <Eigen/Core>
 
-#include "orbis/features/matcher.hpp"  // kThHigh, kThLow, RotationHistogram
+#include "orbis/features/matcher.hpp"  // the search kernels, kThHigh, kThLow, RotationHistogram
 #include "orbis/map/map.hpp"
 #include "orbis/map/frame.hpp"
 

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <span>
 
 #include "orbis/map/map_matching.hpp"
 
@@ -13,9 +15,9 @@ namespace orbis::matching {
 
 namespace detail {
 
-constexpr float kViewCosFrontal = 0.998f;
-
-inline float radiusForViewCos(float viewCos) { return viewCos > kViewCosFrontal ? 2.5f : 4.0f; }
+// A keypoint's slot holds a map point (not a tracking-only point without observations, which a
+// better match may replace).
+inline bool matchedToMapPoint(const MapPoint* slot) { return slot && slot->observationCount() > 0; }
 
 // The camera's observation of a camera-frame point in front of it: (u, v) and, for a stereo
 // camera, the predicted right coordinate (-1 otherwise).
@@ -68,6 +70,7 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
   if constexpr (kStereo) baseline = current.camera->bf() / pinholeOf(*current.camera).fx;
   const bool forward = kStereo && tlc.z() > baseline;
   const bool backward = kStereo && -tlc.z() > baseline;
+  std::vector<int> candidates;
   int matches = 0;
   for (std::size_t i = 0; i < last.size(); ++i) {
     MapPoint* p = last.points[i];
@@ -83,17 +86,15 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
     int minLevel = lastOctave - 1, maxLevel = lastOctave + 1;
     if (forward) { minLevel = lastOctave; maxLevel = levels.levels() - 1; }
     else if (backward) { minLevel = 0; maxLevel = lastOctave; }
-    const auto candidates = cf.grid.featuresInArea(u, v, r, std::max(0, minLevel), maxLevel);
+    cf.grid.featuresInArea(u, v, r, std::max(0, minLevel), maxLevel, candidates);
     const float uRightPred = static_cast<float>(obs.z());
-    int bestDist = 256;
-    std::size_t best = 0;
-    for (std::size_t j : candidates) {
-      if (MapPoint* q = current.points[j]; q && q->observationCount() > 0) continue;
-      if (kStereo && cf.uRight[j] >= 0 && std::abs(uRightPred - cf.uRight[j]) > r) continue;
-      const int d = hammingDistance(p->descriptor(), cf.descriptors[j]);
-      if (d < bestDist) { bestDist = d; best = j; }
-    }
-    if (bestDist <= kThHigh) {
+    // A stereo prediction is checked even when negative (a point nearer than the baseline).
+    const NearestTwo n = nearestTwo(cf, p->descriptor(), candidates, [&](std::size_t j) {
+      return detail::matchedToMapPoint(current.points[j]) ||
+             (kStereo && cf.uRight[j] >= 0 && std::abs(uRightPred - cf.uRight[j]) > r);
+    });
+    if (n.best >= 0 && n.bestDistance <= kThHigh) {
+      const auto best = static_cast<std::size_t>(n.best);
       current.points[best] = p;
       current.outlier[best] = 0;
       ++matches;
@@ -107,32 +108,27 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
 template <CameraModel Camera>
 int matchLocalPoints(Frame<Camera>& frame, const std::vector<MapPoint*>& points, const std::vector<Projection>& projections,
                      float radiusFactor, float ratio) {
-  const FrameFeatures& f = *frame.features;
-  int matches = 0;
+  std::vector<ProjectionQuery> queries;
+  std::vector<MapPoint*> queried;
+  queries.reserve(points.size());
+  queried.reserve(points.size());
   for (std::size_t k = 0; k < points.size(); ++k) {
     MapPoint* p = points[k];
     if (!p || p->isBad()) continue;
     const Projection& pr = projections[k];
-    const float r = radiusFactor * detail::radiusForViewCos(pr.viewCos) * f.scales.scale[static_cast<std::size_t>(pr.level)];
-    const auto candidates = f.grid.featuresInArea(pr.u, pr.v, r, pr.level - 1, pr.level);
-    int bestDist = 256, secondDist = 256, bestLevel = -1, secondLevel = -1;
-    std::size_t best = 0;
-    for (std::size_t j : candidates) {
-      if (MapPoint* q = frame.points[j]; q && q->observationCount() > 0) continue;
-      if (pr.uRight >= 0 && f.uRight[j] >= 0 && std::abs(pr.uRight - f.uRight[j]) > r) continue;
-      const int d = hammingDistance(p->descriptor(), f.descriptors[j]);
-      if (d < bestDist) {
-        secondDist = bestDist; secondLevel = bestLevel;
-        bestDist = d; bestLevel = f.keypointsUn[j].octave; best = j;
-      } else if (d < secondDist) {
-        secondDist = d; secondLevel = f.keypointsUn[j].octave;
-      }
-    }
-    if (bestDist > kThHigh) continue;
-    if (bestLevel == secondLevel && bestDist > ratio * secondDist) continue;
-    frame.points[best] = p;
-    frame.outlier[best] = 0;
-    ++matches;
+    queries.push_back({pr.u, pr.v, pr.uRight, pr.level, pr.viewCos, p->descriptor()});
+    queried.push_back(p);
+  }
+  std::vector<std::uint8_t> taken(frame.size());
+  for (std::size_t j = 0; j < frame.size(); ++j) taken[j] = detail::matchedToMapPoint(frame.points[j]) ? 1 : 0;
+  std::vector<int> keypointOf;
+  const int matches = searchByProjection(*frame.features, std::span<const ProjectionQuery>(queries), radiusFactor, ratio,
+                                         taken, keypointOf);
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    if (keypointOf[q] < 0) continue;
+    const auto j = static_cast<std::size_t>(keypointOf[q]);
+    frame.points[j] = queried[q];
+    frame.outlier[j] = 0;
   }
   return matches;
 }
@@ -144,33 +140,19 @@ int matchByBow(const KeyFrame& kf, const Frame<Camera>& frame, std::vector<MapPo
   out.assign(frame.size(), nullptr);
   RotationHistogram hist;
   int matches = 0;
-  const auto& a = kf.featureVector();
-  const auto& b = frame.featureVector;
-  std::size_t ia = 0, ib = 0;
-  while (ia < a.size() && ib < b.size()) {
-    const auto nodeA = a.node(ia), nodeB = b.node(ib);
-    if (nodeA < nodeB) { ++ia; continue; }
-    if (nodeB < nodeA) { ++ib; continue; }
-    for (std::uint32_t i : a.featuresOf(ia)) {
+  bow::forEachSharedNode(kf.featureVector(), frame.featureVector, [&](auto kfFeatures, auto frameFeatures) {
+    for (std::uint32_t i : kfFeatures) {
       MapPoint* p = kf.point(i);
       if (!p || p->isBad()) continue;
-      int bestDist = 256, secondDist = 256;
-      std::uint32_t best = 0;
-      for (std::uint32_t j : b.featuresOf(ib)) {
-        if (out[j]) continue;
-        const int d = hammingDistance(kff.descriptors[i], ff.descriptors[j]);
-        if (d < bestDist) { secondDist = bestDist; bestDist = d; best = j; }
-        else if (d < secondDist) secondDist = d;
-      }
-      if (bestDist <= kThLow && bestDist < ratio * secondDist) {
+      const NearestTwo n = nearestTwo(ff, kff.descriptors[i], frameFeatures, [&](std::size_t j) { return out[j] != nullptr; });
+      if (n.best >= 0 && n.bestDistance <= kThLow && n.bestDistance < ratio * static_cast<float>(n.secondDistance)) {
+        const auto best = static_cast<std::size_t>(n.best);
         out[best] = p;
         ++matches;
         if (checkOrientation) hist.add(kff.keypointsUn[i].angle - ff.keypointsUn[best].angle, static_cast<int>(best));
       }
     }
-    ++ia;
-    ++ib;
-  }
+  });
   if (checkOrientation) matches -= hist.clearRejected(out);
   return matches;
 }
@@ -181,6 +163,7 @@ int matchFromKeyFrame(Frame<Camera>& frame, const KeyFrame& kf, const std::set<M
   const FrameFeatures& f = *frame.features;
   const Eigen::Vector3d center = frame.cameraCenter();
   RotationHistogram hist;
+  std::vector<int> candidates;
   int matches = 0;
   for (std::size_t i = 0; i < kf.size(); ++i) {
     MapPoint* p = kf.point(i);
@@ -195,14 +178,10 @@ int matchFromKeyFrame(Frame<Camera>& frame, const KeyFrame& kf, const std::set<M
     if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;
     const int level = p->predictScale(dist, f.scales.levels(), f.scales.logFactor());
     const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
-    int bestDist = 256;
-    std::size_t best = 0;
-    for (std::size_t j : f.grid.featuresInArea(u, v, r, level - 1, level + 1)) {
-      if (frame.points[j]) continue;
-      const int d = hammingDistance(p->descriptor(), f.descriptors[j]);
-      if (d < bestDist) { bestDist = d; best = j; }
-    }
-    if (bestDist <= maxDistance) {
+    f.grid.featuresInArea(u, v, r, level - 1, level + 1, candidates);
+    const NearestTwo n = nearestTwo(f, p->descriptor(), candidates, [&](std::size_t j) { return frame.points[j] != nullptr; });
+    if (n.best >= 0 && n.bestDistance <= maxDistance) {
+      const auto best = static_cast<std::size_t>(n.best);
       frame.points[best] = p;
       frame.outlier[best] = 0;
       ++matches;
@@ -225,30 +204,21 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Cam
   std::vector<std::uint8_t> taken2(kf2.size(), 0);
   std::vector<long> matched1(kf1.size(), -1);
   RotationHistogram hist;
-  const auto& a = kf1.featureVector();
-  const auto& b = kf2.featureVector();
-  std::size_t ia = 0, ib = 0;
-  while (ia < a.size() && ib < b.size()) {
-    const auto nodeA = a.node(ia), nodeB = b.node(ib);
-    if (nodeA < nodeB) { ++ia; continue; }
-    if (nodeB < nodeA) { ++ib; continue; }
-    for (std::uint32_t i : a.featuresOf(ia)) {
+  bow::forEachSharedNode(kf1.featureVector(), kf2.featureVector(), [&](auto features1, auto features2) {
+    for (std::uint32_t i : features1) {
       if (kf1.point(i)) continue;
       const Keypoint& k1 = f1.keypointsUn[i];
       // x2ᵀ F12 x1 = 0, so the epipolar line of x1 in kf2 is F12 x1; candidates share the node.
       const Eigen::Vector3d line = F12 * Eigen::Vector3d(k1.u, k1.v, 1.0);
-      const long best = orbis::detail::bestEpipolarPartner(
-          f1, i, f2, b.featuresOf(ib), line, epipole, onlyStereo,
-          [&](std::size_t j) { return kf2.point(j) != nullptr || taken2[j]; }, HammingDistance{});
+      const long best = bestEpipolarPartner(f1, i, f2, features2, line, epipole, onlyStereo,
+                                            [&](std::size_t j) { return kf2.point(j) != nullptr || taken2[j]; });
       if (best >= 0) {
         taken2[static_cast<std::size_t>(best)] = 1;
         matched1[i] = best;
         hist.add(k1.angle - f2.keypointsUn[static_cast<std::size_t>(best)].angle, static_cast<int>(i));
       }
     }
-    ++ia;
-    ++ib;
-  }
+  });
   std::vector<int> rejected;
   hist.rejected(rejected);
   for (int i : rejected) matched1[static_cast<std::size_t>(i)] = -1;
@@ -263,6 +233,7 @@ int fuse(const Camera& camera, KeyFrame& kf, const std::vector<MapPoint*>& point
   const FrameFeatures& f = kf.features();
   const SE3d Tcw = kf.Tcw();
   const Eigen::Vector3d center = kf.cameraCenter();
+  std::vector<int> candidates;
   int fused = 0;
   for (MapPoint* p : points) {
     if (!p || p->isBad() || p->isObservedBy(&kf)) continue;
@@ -278,24 +249,23 @@ int fuse(const Camera& camera, KeyFrame& kf, const std::vector<MapPoint*>& point
     if (p->normal().norm() > 0 && po.dot(p->normal()) < 0.5 * dist * p->normal().norm()) continue;
     const int level = p->predictScale(dist, f.scales.levels(), f.scales.logFactor());
     const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
-    int bestDist = 256;
-    long best = -1;
-    for (std::size_t j : f.grid.featuresInArea(static_cast<float>(u), static_cast<float>(v), r)) {
+    f.grid.featuresInArea(static_cast<float>(u), static_cast<float>(v), r, -1, -1, candidates);
+    // Candidates on the predicted level or the one below whose reprojection error passes χ²
+    // at 95% (2 degrees of freedom, 3 with a right coordinate).
+    const auto reprojectionTooFar = [&](std::size_t j) {
       const Keypoint& k = f.keypointsUn[j];
-      if (k.octave < level - 1 || k.octave > level) continue;
+      if (k.octave < level - 1 || k.octave > level) return true;
       const double ex = u - k.u, ey = v - k.v;
       const double inv2 = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
       if (f.uRight[j] >= 0) {
         const double er = ur - f.uRight[j];
-        if ((ex * ex + ey * ey + er * er) * inv2 > 7.8) continue;
-      } else if ((ex * ex + ey * ey) * inv2 > 5.99) {
-        continue;
+        return (ex * ex + ey * ey + er * er) * inv2 > 7.8;
       }
-      const int d = hammingDistance(p->descriptor(), f.descriptors[j]);
-      if (d < bestDist) { bestDist = d; best = static_cast<long>(j); }
-    }
-    if (best < 0 || bestDist > kThLow) continue;
-    const auto j = static_cast<std::size_t>(best);
+      return (ex * ex + ey * ey) * inv2 > 5.99;
+    };
+    const NearestTwo n = nearestTwo(f, p->descriptor(), candidates, reprojectionTooFar);
+    if (n.best < 0 || n.bestDistance > kThLow) continue;
+    const auto j = static_cast<std::size_t>(n.best);
     if (MapPoint* existing = kf.point(j); existing && !existing->isBad()) {
       // Keep the better-observed point; the other is merged into it.
       if (existing->observationCount() > p->observationCount()) p->replaceWith(existing);
