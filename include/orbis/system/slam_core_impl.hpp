@@ -90,6 +90,7 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     if (loopCloser_) loopCloser_->runUntilIdle();
   }
   if (frameObserver_) {
+    ScopedStage stage(&timer_, "tracking: observer");  // what watching costs the tracking thread
     FrameSnapshot snapshot;
     snapshot.index = frames_ - 1;
     snapshot.timestamp = timestamp;
