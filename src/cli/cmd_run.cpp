@@ -87,6 +87,11 @@ int runCommand(const std::vector<std::string>& rawArgs) {
   const RunReport r = runDataset(*dataset, options);
   printReport(r, options, p.has("--json"));
 #ifdef ORBIS_HAS_VIEWER
+  if (viewer) {
+    const ViewerStats v = viewer->stats();
+    std::fprintf(stderr, "viewer: %zu frame and %zu map messages, %.1f MB, %.3f s CPU on its publisher thread over %.1f s\n",
+                 v.frameMessages, v.mapMessages, 1e-6 * static_cast<double>(v.bytes), v.publisherCpuSeconds, r.seconds);
+  }
   if (viewer && p.has("--viewer-wait")) {
     std::fprintf(stderr, "viewer: serving the finished run at %s; Ctrl-C to stop\n", viewer->url().c_str());
     waitUntilInterrupted();

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <thread>
+#include <time.h>
 #include <unordered_set>
 
 #include "orbis/util/error.hpp"
@@ -91,6 +92,10 @@ struct LiveViewer::Impl {
   std::mutex sourceMutex;  // held while a snapshot is taken: detach() waits for it, onFrame() never
   MapSnapshotSource source;
 
+  std::mutex statsMutex;
+  ViewerStats stats;
+
+  void countMessage(bool map, std::size_t bytes);
   void serveRoutes();
   void streamEvents(httplib::Response& response);
   void publishLoop();
@@ -129,13 +134,27 @@ void LiveViewer::Impl::streamEvents(httplib::Response& response) {
       [this](bool) { --clients; });
 }
 
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+void LiveViewer::Impl::countMessage(bool map, std::size_t bytes) {
+  std::lock_guard lock(statsMutex);
+  ++(map ? stats.mapMessages : stats.frameMessages);
+  stats.bytes += bytes;
+}
+
 void LiveViewer::Impl::publishMap(const MapSnapshot& map, bool live) {
   std::unordered_set<MapPointId> local;
   {
     std::lock_guard lock(mutex);
     local.insert(localMap.begin(), localMap.end());
   }
-  messages.publish(LatestMessages::kMap, mapMessage(map, local, live));
+  std::string message = mapMessage(map, local, live);
+  countMessage(true, message.size());
+  messages.publish(LatestMessages::kMap, std::move(message));
 }
 
 void LiveViewer::Impl::publishLoop() {
@@ -154,7 +173,9 @@ void LiveViewer::Impl::publishLoop() {
       pendingFrame.reset();
       localMap = std::move(frame.localMapPoints);
       lock.unlock();
-      messages.publish(LatestMessages::kFrame, frameMessage(frame));
+      std::string message = frameMessage(frame);
+      countMessage(false, message.size());
+      messages.publish(LatestMessages::kFrame, std::move(message));
       lock.lock();
       lastFrame = now;
     }
@@ -169,6 +190,8 @@ void LiveViewer::Impl::publishLoop() {
       lastMap = now;
     }
     clientsAtLastMap = clients;
+    std::lock_guard statsLock(statsMutex);
+    stats.publisherCpuSeconds = threadCpuSeconds();
   }
 }
 
@@ -200,6 +223,11 @@ LiveViewer::~LiveViewer() {
 
 std::string LiveViewer::url() const {
   return "http://" + impl_->options.host + ":" + std::to_string(impl_->options.port) + "/";
+}
+
+ViewerStats LiveViewer::stats() const {
+  std::lock_guard lock(impl_->statsMutex);
+  return impl_->stats;
 }
 
 void LiveViewer::attach(MapSnapshotSource source) {

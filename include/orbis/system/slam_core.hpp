@@ -8,6 +8,7 @@
 // slam_core_impl.hpp; the built-in sensors are compiled in src/system/slam_core.cpp.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <vector>
@@ -99,7 +100,8 @@ class SlamCore {
   std::unique_ptr<LocalMapper<Sensor>> mapper_;
   std::unique_ptr<LoopCloser<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
   std::unique_ptr<Tracker<Sensor>> tracker_;
-  std::uint64_t frames_ = 0, lost_ = 0;
+  std::atomic<std::uint64_t> frames_{0};  // atomic: mapSnapshot() reads it from an observer's thread
+  std::uint64_t lost_ = 0;
   FrameObserver frameObserver_;
   bool shutDown_ = false;
 };

@@ -25,6 +25,13 @@ struct ViewerOptions {
   double mapRateHz = 5;     // map snapshots per second, at most
 };
 
+// What the viewer did, for the overhead it adds: messages built and the CPU time of its
+// publisher thread (snapshots and JSON; the server's threads only copy bytes to sockets).
+struct ViewerStats {
+  std::size_t frameMessages = 0, mapMessages = 0, bytes = 0;
+  double publisherCpuSeconds = 0;
+};
+
 class LiveViewer final : public SlamObserver {
  public:
   explicit LiveViewer(ViewerOptions options = {});
@@ -33,6 +40,7 @@ class LiveViewer final : public SlamObserver {
   LiveViewer& operator=(const LiveViewer&) = delete;
 
   std::string url() const;
+  ViewerStats stats() const;
 
   void attach(MapSnapshotSource source) override;
   void onFrame(FrameSnapshot&& frame) override;

@@ -273,9 +273,12 @@ function buildControls() {
 }
 
 // The stream closes by itself once the run has finished (its map will not change), or, with
-// ?maps=N in the address, after N map messages (a headless browser waits for open requests).
+// ?maps=N in the address, after N map messages, or with ?loops=N after the map that shows the
+// N-th loop closure: a headless browser takes its screenshot once no request is open.
 function connect() {
-  const closeAfterMaps = Number(new URLSearchParams(location.search).get('maps')) || Infinity;
+  const query = new URLSearchParams(location.search);
+  const closeAfterMaps = Number(query.get('maps')) || Infinity;
+  const closeAfterLoops = Number(query.get('loops')) || Infinity;
   let maps = 0;
   const events = new EventSource('events');
   events.addEventListener('frame', (e) => {
@@ -285,7 +288,8 @@ function connect() {
   events.addEventListener('map', (e) => {
     view.latestMap = JSON.parse(e.data);
     if (!view.paused) applyMap(view.latestMap);
-    if (!view.latestMap.live || ++maps >= closeAfterMaps) events.close();
+    if (!view.latestMap.live || ++maps >= closeAfterMaps || view.latestMap.loopClosures.length >= closeAfterLoops)
+      events.close();
   });
   events.onerror = () => { ui('mode').textContent = '— disconnected (retrying)'; };
 }
