@@ -72,7 +72,9 @@ function pushFrustum(out, T, size) {
 
 function pointColours(points, maxKeyFrame) {
   const colours = new Float32Array(points.length / 5 * 3);
-  const byLocalMap = view.colouring === 'local';
+  let anyLocal = false;  // a finished run's folder or a map file has no local map: colour by age
+  for (let i = 4; i < points.length && !anyLocal; i += 5) anyLocal = points[i] === 1;
+  const byLocalMap = view.colouring === 'local' && anyLocal;
   for (let i = 0, j = 0; i < points.length; i += 5, j += 3) {
     if (byLocalMap) {
       const local = points[i + 4] === 1;
