@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The live viewer as a person uses it: `orbis run --viewer` on a rendered loop, the page loaded in
-# headless Chromium while SLAM runs and after it has finished; the scene the page holds
-# (window.orbisScene, mirrored in #scene-state) must match the run's report.json. Screenshots:
+# The live viewer as a person uses it: `orbis run --viewer` on a rendered loop (closed at frame
+# ~119, then 120 frames more over known ground), the page loaded in headless Chromium while SLAM
+# runs — its screenshot is taken once the page has seen the loop closure, or at the latest when
+# the run ends — and after it has finished; the scene the page holds (window.orbisScene,
+# mirrored in #scene-state) must match the run's report.json. Screenshots:
 # WORK_DIR/viewer_live.png and WORK_DIR/viewer_final.png.
 #
 # Usage: viewer_page_test.sh ORBIS_BINARY WORK_DIR
@@ -17,7 +19,8 @@ fi
 mkdir -p "$work"
 rm -rf "$work/out" "$work"/viewer_*.png
 if [[ ! -f $work/synth/rgb.txt ]]; then
-  "$orbis" synth "$work/synth" --layout tum --frames 120 --width 320 --height 240 --fx 250 --seed 3 >/dev/null
+  "$orbis" synth "$work/synth" --layout tum --frames 120 --extra 120 --width 320 --height 240 --fx 250 --seed 3 \
+    --threads 2 >/dev/null
 fi
 
 browse() {  # browse URL ARGS...: headless Chromium, bounded in time, its chatter dropped
@@ -41,8 +44,9 @@ done
 trap 'kill -INT $pid 2>/dev/null || true' EXIT
 url="http://127.0.0.1:$port/"
 
-# While SLAM runs: the page connects and shows whatever is there (the run may finish first).
-browse "$url?maps=2" --screenshot="$work/viewer_live.png" >/dev/null
+# While SLAM runs: the page closes its stream (and Chromium takes the picture) once a loop closure
+# has arrived, or when the run is over if the page connected that late.
+browse "$url?loops=1" --screenshot="$work/viewer_live.png" >/dev/null
 for _ in $(seq 600); do
   grep -q "serving the finished run" "$work/run.log" && break
   kill -0 "$pid" 2>/dev/null || { echo "orbis run ended early:"; cat "$work/run.log"; exit 1; }
@@ -64,6 +68,7 @@ assert scene["keyframes"] == report["keyframes"], "keyframes differ"
 assert scene["points"] == report["map_points"], "map points differ"
 assert scene["frames"] == report["frames"], "frames differ"
 assert scene["live"] is False, "the page should show the finished run"
+assert scene["loopClosures"] >= 1, "the rendered loop should have closed"
 PY
 for shot in viewer_live viewer_final; do
   [[ -s $work/$shot.png ]] || { echo "no screenshot $shot.png"; exit 1; }
