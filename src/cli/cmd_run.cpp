@@ -25,11 +25,13 @@ std::vector<std::string> withViewerPort(std::vector<std::string> args) {
 
 void printReport(const RunReport& r, const RunOptions& options, bool json);
 
+#ifdef ORBIS_HAS_VIEWER
 int viewerPort(const ArgParser& p) {
   const long port = p.getInt("--viewer");
   if (port < 1 || port > 65535) throw Error("argument --viewer", "", "expects a port between 1 and 65535");
   return static_cast<int>(port);
 }
+#endif
 
 int runCommand(const std::vector<std::string>& rawArgs) {
   const std::vector<std::string> args = withViewerPort(rawArgs);
