@@ -111,7 +111,14 @@ void LiveViewer::Impl::serveRoutes() {
       response.status = 404;
       return;
     }
-    response.set_content(reinterpret_cast<const char*>(asset->data), asset->size, std::string(asset->contentType).c_str());
+    // Straight from the embedded bytes, uncompressed: httplib would brotli-compress a body (850 kB
+    // of three.js) on every request, on the machine that runs SLAM.
+    response.set_content_provider(
+        asset->size, std::string(asset->contentType),
+        [asset](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+          return sink.write(reinterpret_cast<const char*>(asset->data) + offset, length);
+        },
+        [](bool) {});
   });
 }
 

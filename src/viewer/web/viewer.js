@@ -33,6 +33,7 @@ scene.add(world);
 const camera = new THREE.PerspectiveCamera(55, 1, 0.005, 500);
 camera.position.set(0, 2, -3);
 const controls = renderer ? new THREE.OrbitControls(camera, renderer.domElement) : null;
+if (controls) controls.addEventListener('change', () => requestRender());
 const layers = {};
 for (const name of Object.keys(LAYERS)) {
   layers[name] = new THREE.Group();
@@ -207,6 +208,7 @@ function applyFrame(frame) {
   drawImage(frame);
   drawCurrentCamera(frame);
   followCamera();
+  requestRender();
 }
 
 function announceLoops(closures) {
@@ -242,6 +244,7 @@ function applyMap(map) {
     view.fitted = true;
   }
   ui('scene-state').textContent = JSON.stringify(window.orbisScene);
+  requestRender();
 }
 
 // ---- controls and stream ---------------------------------------------------------------------------
@@ -249,7 +252,10 @@ function buildControls() {
   for (const [name, label] of Object.entries(LAYERS)) {
     const box = document.createElement('label');
     box.innerHTML = `<input type="checkbox" checked> ${label}`;
-    box.firstChild.addEventListener('change', (e) => { layers[name].visible = e.target.checked; });
+    box.firstChild.addEventListener('change', (e) => {
+      layers[name].visible = e.target.checked;
+      requestRender();
+    });
     ui('layers').appendChild(box);
   }
   ui('camera-mode').addEventListener('change', (e) => {
@@ -259,10 +265,12 @@ function buildControls() {
   ui('point-size').addEventListener('input', (e) => {
     view.pointSize = Number(e.target.value);
     for (const p of layers.points.children) p.material.size = view.pointSize;
+    requestRender();
   });
   ui('colouring').addEventListener('change', (e) => {
     view.colouring = e.target.value;
     if (view.latestMap) drawPoints(view.latestMap);
+    requestRender();
   });
   ui('pause').addEventListener('click', () => {
     view.paused = !view.paused;
@@ -296,17 +304,27 @@ function connect() {
   events.onerror = () => { ui('mode').textContent = '— disconnected (retrying)'; };
 }
 
-function resize() {
+function resize() {  // true when the canvas changed size
   const w = canvas.clientWidth, h = canvas.clientHeight;
-  if (renderer && (canvas.width !== w || canvas.height !== h)) renderer.setSize(w, h, false);
+  if (!renderer || (canvas.width === w && canvas.height === h)) return false;
+  renderer.setSize(w, h, false);
   camera.aspect = w / Math.max(1, h);
   camera.updateProjectionMatrix();
+  return true;
 }
+
+// Draws only when something changed (a message, the mouse, the window): a browser on the
+// machine that runs SLAM then takes little CPU from it.
+let needsRender = true;
+function requestRender() { needsRender = true; }
 
 function animate() {
   requestAnimationFrame(animate);
-  resize();
-  if (renderer) renderer.render(scene, camera);
+  if (resize()) needsRender = true;
+  if (renderer && needsRender) {
+    renderer.render(scene, camera);
+    needsRender = false;
+  }
 }
 
 buildControls();
