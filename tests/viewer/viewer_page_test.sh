@@ -41,7 +41,9 @@ for port in 18751 18752 18753 18754 18755; do
   pid=""
 done
 [[ -n $pid ]] || { echo "no free port"; cat "$work/run.log"; exit 1; }
-trap 'kill -INT $pid 2>/dev/null || true' EXIT
+# TERM, not INT: a script's background job starts with SIGINT ignored until orbis installs its
+# Ctrl-C handler, so an early exit would leave it serving.
+trap 'kill -TERM $pid 2>/dev/null || true; wait $pid 2>/dev/null || true' EXIT
 url="http://127.0.0.1:$port/"
 
 # While SLAM runs: the page closes its stream (and Chromium takes the picture) once a loop closure
