@@ -2,12 +2,16 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <memory>
 
 #include "command.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
 #include "orbis/util/warnings.hpp"
+#ifdef ORBIS_HAS_VIEWER
+#include "orbis/viewer/live_viewer.hpp"
+#endif
 
 namespace orbis::cli {
 namespace {
@@ -33,7 +37,26 @@ void requireSomethingTracked(const DatasetReader& dataset, const RunReport& r) {
                               "the vocabulary (--vocab) and that the images are not blank");
 }
 
-int runCommand(const std::vector<std::string>& args) {
+// `--viewer` may stand without its PORT: give it the default.
+std::vector<std::string> withViewerPort(std::vector<std::string> args) {
+  for (std::size_t i = 0; i < args.size(); ++i)
+    if (args[i] == "--viewer" && (i + 1 == args.size() || args[i + 1].rfind("--", 0) == 0))
+      args[i] = "--viewer=8080";
+  return args;
+}
+
+void printReport(const RunReport& r, const RunOptions& options, bool json);
+
+#ifdef ORBIS_HAS_VIEWER
+int viewerPort(const ArgParser& p) {
+  const long port = p.getInt("--viewer");
+  if (port < 1 || port > 65535) throw Error("argument --viewer", "", "expects a port between 1 and 65535");
+  return static_cast<int>(port);
+}
+#endif
+
+int runCommand(const std::vector<std::string>& rawArgs) {
+  const std::vector<std::string> args = withViewerPort(rawArgs);
   ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
               "Runs SLAM over a dataset sequence and writes DIR/trajectory.txt, keyframes.txt, report.json,\n"
               "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.\n"
@@ -52,7 +75,9 @@ int runCommand(const std::vector<std::string>& args) {
       .option("--load-map", "FILE", "start from a saved map (same sensor, camera and vocabulary) and relocalise in it")
       .option("--save-map", "FILE", "save the final map (keyframes, points, graphs) for a later --load-map")
       .flag("--no-loop", "disable loop closing")
-      .flag("--json", "print the report as JSON on standard output");
+      .flag("--json", "print the report as JSON on standard output")
+      .option("--viewer", "[PORT]", "serve a live view of the run at http://127.0.0.1:PORT/ (default port 8080)")
+      .flag("--viewer-wait", "with --viewer: keep serving the finished run until Ctrl-C");
   if (!p.parse(args)) return 0;
   DatasetOptions datasetOptions;
   datasetOptions.tolerateBadFrames = true;  // a bad frame is reported and skipped, not the end of the run
@@ -75,12 +100,38 @@ int runCommand(const std::vector<std::string>& args) {
   options.maxFrames = static_cast<std::size_t>(maxFrames);
   options.progress = !p.has("--json");
 
+#ifdef ORBIS_HAS_VIEWER
+  std::unique_ptr<LiveViewer> viewer;
+  if (p.has("--viewer")) {
+    viewer = std::make_unique<LiveViewer>(ViewerOptions{"127.0.0.1", viewerPort(p), 15, 5});
+    std::fprintf(stderr, "viewer: %s\n", viewer->url().c_str());
+    options.observer = viewer.get();
+  }
+#else
+  if (p.has("--viewer")) throw Error("argument --viewer", "", "this orbis was built without the viewer (ORBIS_BUILD_VIEWER)");
+#endif
   const RunReport r = runDataset(*dataset, options);
-  if (p.has("--json")) {
+  printReport(r, options, p.has("--json"));
+#ifdef ORBIS_HAS_VIEWER
+  if (viewer) {
+    const ViewerStats v = viewer->stats();
+    std::fprintf(stderr, "viewer: %zu frame and %zu map messages, %.1f MB, %.3f s CPU on its publisher thread over %.1f s\n",
+                 v.frameMessages, v.mapMessages, 1e-6 * static_cast<double>(v.bytes), v.publisherCpuSeconds, r.seconds);
+  }
+  if (viewer && p.has("--viewer-wait")) {
+    std::fprintf(stderr, "viewer: serving the finished run at %s; Ctrl-C to stop\n", viewer->url().c_str());
+    waitUntilInterrupted();
+  }
+#endif
+  requireSomethingTracked(*dataset, r);
+  return 0;
+}
+
+void printReport(const RunReport& r, const RunOptions& options, bool json) {
+  if (json) {
     std::ifstream in(options.outDir / "report.json");
     std::printf("%s", std::string(std::istreambuf_iterator<char>(in), {}).c_str());
-    requireSomethingTracked(*dataset, r);
-    return 0;
+    return;
   }
   std::printf("dataset        %s (%s)\n", r.dataset.c_str(), r.sensor.c_str());
   std::printf("frames         %zu  tracked %zu  lost %zu\n", r.stats.frames, r.stats.tracked, r.stats.lost);
@@ -99,8 +150,6 @@ int runCommand(const std::vector<std::string>& args) {
   for (const auto& w : readableWarnings(foldWarnings(r.warnings))) std::fprintf(stderr, "warning: %s\n", w.c_str());
   std::printf("\noutputs in %s (trajectory.txt, keyframes.txt, report.json, map.ply, overview.png)\n",
               options.outDir.string().c_str());
-  requireSomethingTracked(*dataset, r);
-  return 0;
 }
 
 ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI odometry and raw)", runCommand);

@@ -1,6 +1,9 @@
 #include "command.hpp"
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
+#include <thread>
 #include <sstream>
 
 #include "orbis/util/error.hpp"
@@ -123,5 +126,16 @@ bool registerCommand(Command command) {
 }
 
 const std::map<std::string, Command>& commands() { return registry(); }
+
+namespace {
+volatile std::sig_atomic_t interrupted = 0;
+extern "C" void onInterrupt(int) { interrupted = 1; }
+}  // namespace
+
+void waitUntilInterrupted() {
+  std::signal(SIGINT, onInterrupt);
+  std::signal(SIGTERM, onInterrupt);
+  while (!interrupted) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+}
 
 }  // namespace orbis::cli

@@ -63,6 +63,8 @@ struct Command {
 };
 
 bool registerCommand(Command command);
+// Blocks until SIGINT or SIGTERM (Ctrl-C), e.g. while a viewer serves a finished run.
+void waitUntilInterrupted();
 const std::map<std::string, Command>& commands();
 
 }  // namespace orbis::cli

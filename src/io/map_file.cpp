@@ -257,11 +257,10 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
   writeFileAtomically(file, w.bytes());
 }
 
-MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expected) {
-  const std::string file = path.string();
-  if (map.createdKeyFrames() != 0 || map.createdMapPoints() != 0)
-    throw fileError(file, "a map file can only be loaded into an empty map");
-  const std::vector<char> bytes = readWholeFile(path);
+namespace {
+
+// Checks size, magic, version, declared size and checksum of a whole map file; returns its header.
+MapFileInfo checkedHeader(const std::vector<char>& bytes, const std::string& file) {
   if (bytes.size() < kHeaderBytes + kTrailerBytes)
     throw fileError(file, "truncated map file: " + std::to_string(bytes.size()) + " bytes, shorter than the header");
   if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
@@ -290,6 +289,19 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
   info.intrinsics = header.getIntrinsics("camera");
   info.keyFrames = header.get<std::uint64_t>("keyframe count");
   info.mapPoints = header.get<std::uint64_t>("map point count");
+  return info;
+}
+
+}  // namespace
+
+MapFileInfo readMapFileInfo(const fs::path& path) { return checkedHeader(readWholeFile(path), path.string()); }
+
+MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expected) {
+  const std::string file = path.string();
+  if (map.createdKeyFrames() != 0 || map.createdMapPoints() != 0)
+    throw fileError(file, "a map file can only be loaded into an empty map");
+  const std::vector<char> bytes = readWholeFile(path);
+  const MapFileInfo info = checkedHeader(bytes, file);
   if (info.sensor != expected.sensor)
     throw fileError(file, "map made with sensor " + std::string(toString(info.sensor)) + ", this system's sensor is " +
                               std::string(toString(expected.sensor)));

@@ -119,6 +119,10 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
     slam.core().loadMap(*options.loadMap);
     report.keyFramesLoaded = slam.core().loadedKeyFrames();
   }
+  if (options.observer) {
+    slam.setFrameObserver([observer = options.observer](FrameSnapshot&& frame) { observer->onFrame(std::move(frame)); });
+    options.observer->attach([&slam] { return slam.mapSnapshot(); });
+  }
 
   for (const auto& w : dataset.warnings()) report.warnings.push_back(w);
   const std::size_t n = options.maxFrames ? std::min(options.maxFrames, dataset.size()) : dataset.size();
@@ -168,6 +172,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   }
   bar.finish();
   slam.shutdown();
+  if (options.observer) options.observer->detach(slam.mapSnapshot());
   if (options.saveMap && !failure) slam.core().saveMap(*options.saveMap);
   const RelocalisationStats relocalisation = slam.core().relocalisationStats();
   report.relocalisationAttempts = relocalisation.attempts;

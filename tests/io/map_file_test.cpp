@@ -266,3 +266,21 @@ TEST(MapFile, VocabularyChecksumTellsVocabulariesApart) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(MapFile, InfoReadsTheHeaderAndChecksTheFile) {
+  const fs::path file = savedMap("info.map");
+  const MapFileInfo info = readMapFileInfo(file);
+  EXPECT_EQ(info.sensor, expectation().sensor);
+  EXPECT_EQ(info.vocabularyChecksum, expectation().vocabularyChecksum);
+  EXPECT_EQ(info.keyFrames, 4u);
+  Map map;
+  EXPECT_EQ(readMapFile(file, map, info).keyFrames, 4u);  // what a reader of any map passes
+  std::vector<char> bytes = readBytes(file);
+  bytes[bytes.size() / 2] ^= 1;
+  writeBytes(file, bytes);
+  EXPECT_THROW(readMapFileInfo(file), Error);
+}
+
+}  // namespace

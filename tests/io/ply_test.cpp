@@ -34,3 +34,16 @@ TEST(Ply, UnwritablePathNamesTheFile) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/x.ply"), std::string::npos);
   }
 }
+
+TEST(Ply, ReadsBackWhatItWrote) {
+  const auto path = std::filesystem::temp_directory_path() / "orbis_ply_read_test.ply";
+  const std::vector<Eigen::Vector3f> points{{1, 2, 3}, {-4, 5.5f, 6}};
+  orbis::writePly(path, points, {{{255, 0, 0}}, {{0, 255, 0}}});
+  const std::vector<Eigen::Vector3f> read = orbis::readPly(path);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[1], points[1]);
+  orbis::writePly(path, points);
+  EXPECT_EQ(orbis::readPly(path)[0], points[0]);
+  std::filesystem::remove(path);
+  EXPECT_THROW(orbis::readPly(path), orbis::Error);
+}

@@ -48,4 +48,8 @@ void writeMapFile(const std::filesystem::path& file, const Map& map, const MapFi
 // file's header (counts as loaded).
 MapFileInfo readMapFile(const std::filesystem::path& file, Map& map, const MapFileInfo& expected);
 
+// The header of a map file, after the same checks as readMapFile up to (not including) the
+// caller's expectations: what a reader that accepts any map (the viewer) passes as `expected`.
+MapFileInfo readMapFileInfo(const std::filesystem::path& file);
+
 }  // namespace orbis

@@ -1,7 +1,8 @@
 // orbis/io/ply.hpp — writes point clouds as binary little-endian PLY (x, y, z float; optional rgb).
 //
 // Contract: writePly throws orbis::Error naming the path when the file cannot be written;
-// colours, when given, must have one entry per point.
+// colours, when given, must have one entry per point. readPly reads back the points of such a
+// file (binary little-endian, float x, y, z first); another layout is an orbis::Error.
 #pragma once
 
 #include <array>
@@ -15,5 +16,7 @@ namespace orbis {
 
 void writePly(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& points,
               const std::vector<std::array<std::uint8_t, 3>>& colours = {});
+
+std::vector<Eigen::Vector3f> readPly(const std::filesystem::path& path);
 
 }  // namespace orbis

@@ -9,7 +9,8 @@
 // dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
 // A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
 // later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
-// else from the dataset's own calibration.
+// else from the dataset's own calibration. RunOptions::observer, when set, sees every frame and
+// takes map snapshots while the run lasts, and gets the final map after shutdown.
 #pragma once
 
 #include <filesystem>
@@ -35,6 +36,7 @@ struct RunOptions {
   bool progress = true;
   std::optional<std::filesystem::path> loadMap;  // map file to localise in (io/map_file.hpp)
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
+  SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned
 };
 
 struct RunReport {

@@ -10,6 +10,7 @@
 // joins the threads; the trajectory and map stay readable afterwards.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -31,11 +32,15 @@ class Slam {
 
   TrackResult track(const Input& input) {
     std::shared_ptr<const FrameFeatures> features;
+    double extractionMs = 0;
     {
+      using Clock = std::chrono::steady_clock;
+      const Clock::time_point start = core_.observesFrames() ? Clock::now() : Clock::time_point{};
       ScopedStage stage(&core_.timer(), "tracking: ORB extraction");
       features = std::make_shared<const FrameFeatures>(builder_.build(input));
+      if (core_.observesFrames()) extractionMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     }
-    return core_.track(std::move(features), input.timestamp);
+    return core_.track(std::move(features), input.timestamp, extractionMs);
   }
 
   void shutdown() { core_.shutdown(); }
@@ -45,6 +50,9 @@ class Slam {
   SlamStats stats() const { return core_.stats(); }
   TrackingState state() const { return core_.state(); }
   void setLocalisationOnly(bool on) { core_.setLocalisationOnly(on); }
+  // See SlamCore::setFrameObserver and mapSnapshot (slam_observer.hpp).
+  void setFrameObserver(FrameObserver observer) { core_.setFrameObserver(std::move(observer)); }
+  MapSnapshot mapSnapshot() const { return core_.mapSnapshot(); }
   const StageTimer& timer() const { return core_.timer(); }
   SlamCore<Sensor>& core() { return core_; }
   const SlamCore<Sensor>& core() const { return core_; }

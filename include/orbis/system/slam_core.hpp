@@ -8,6 +8,7 @@
 // slam_core_impl.hpp; the built-in sensors are compiled in src/system/slam_core.cpp.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "orbis/map/map.hpp"
 #include "orbis/mapping/local_mapper.hpp"
 #include "orbis/sensor/sensor.hpp"
+#include "orbis/system/slam_observer.hpp"
 #include "orbis/tracking/relocaliser.hpp"
 #include "orbis/tracking/tracker.hpp"
 #include "orbis/util/timing.hpp"
@@ -49,7 +51,8 @@ class SlamCore {
   SlamCore(const SlamCore&) = delete;
   SlamCore& operator=(const SlamCore&) = delete;
 
-  TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp);
+  // extractionMs: the caller's feature extraction time, passed on to the frame observer.
+  TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp, double extractionMs = 0);
   void shutdown();
 
   Trajectory trajectory() const;          // every tracked frame, camera-to-world
@@ -58,6 +61,12 @@ class SlamCore {
   SlamStats stats() const;
   TrackingState state() const { return tracker_->state(); }
   void setLocalisationOnly(bool on);
+  // Called after every frame on the tracking thread (slam_observer.hpp); set before tracking
+  // starts, empty to remove. Without one, track() does no extra work.
+  void setFrameObserver(FrameObserver observer);
+  bool observesFrames() const { return static_cast<bool>(frameObserver_); }
+  // The map, loop closures and trajectory copied under the map mutex; callable from any thread.
+  MapSnapshot mapSnapshot() const;
 
   // Map files (io/map_file.hpp). saveMap waits for local mapping to finish its queue. loadMap
   // needs a core that has not tracked yet; tracking then starts lost and relocalises in the map.
@@ -91,7 +100,9 @@ class SlamCore {
   std::unique_ptr<LocalMapper<Sensor>> mapper_;
   std::unique_ptr<LoopCloser<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
   std::unique_ptr<Tracker<Sensor>> tracker_;
-  std::uint64_t frames_ = 0, lost_ = 0;
+  std::atomic<std::uint64_t> frames_{0};  // atomic: mapSnapshot() reads it from an observer's thread
+  std::uint64_t lost_ = 0;
+  FrameObserver frameObserver_;
   bool shutDown_ = false;
 };
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 
 #include "orbis/io/map_file.hpp"
 #include "orbis/system/slam_core.hpp"
@@ -61,7 +62,11 @@ void SlamCore<Sensor>::shutdown() {
 }
 
 template <SensorConfiguration Sensor>
-TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> features, double timestamp) {
+TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> features, double timestamp,
+                                    double extractionMs) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = frameObserver_ ? Clock::now() : Clock::time_point{};
+  std::shared_ptr<const FrameFeatures> observed = frameObserver_ ? features : nullptr;
   Frame<Camera> frame;
   frame.index = frames_++;
   frame.timestamp = timestamp;
@@ -84,7 +89,48 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     mapper_->runUntilIdle();
     if (loopCloser_) loopCloser_->runUntilIdle();
   }
+  if (frameObserver_) {
+    ScopedStage stage(&timer_, "tracking: observer");  // what watching costs the tracking thread
+    FrameSnapshot snapshot;
+    snapshot.index = frames_ - 1;
+    snapshot.timestamp = timestamp;
+    snapshot.state = result.state;
+    snapshot.Tcw = result.Tcw;
+    snapshot.inliers = result.inliers;
+    snapshot.newKeyFrame = result.newKeyFrame;
+    snapshot.imageWidth = intrinsics_.maxX;
+    snapshot.imageHeight = intrinsics_.maxY;
+    snapshot.features = std::move(observed);
+    snapshot.keypointStates = tracker_->keypointStates();
+    snapshot.localMapPoints.reserve(tracker_->localMapPoints().size());
+    for (const MapPoint* p : tracker_->localMapPoints()) snapshot.localMapPoints.push_back(p->id);
+    snapshot.extractionMs = extractionMs;
+    snapshot.trackingMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    frameObserver_(std::move(snapshot));
+  }
   return result;
+}
+
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::setFrameObserver(FrameObserver observer) {
+  std::lock_guard lock(map_.mutex());
+  frameObserver_ = std::move(observer);
+  tracker_->setRecordKeypointStates(static_cast<bool>(frameObserver_));
+}
+
+template <SensorConfiguration Sensor>
+MapSnapshot SlamCore<Sensor>::mapSnapshot() const {
+  MapSnapshot snapshot;
+  {
+    std::lock_guard lock(map_.mutex());
+    snapshot = snapshotOfMap(map_);
+    snapshot.trajectory.reserve(tracker_->trackedFrames().size());
+    for (const TrackedFrame& f : tracker_->trackedFrames())
+      snapshot.trajectory.push_back(worldPoseOf(f).inverse().translation().cast<float>());
+    snapshot.frames = frames_;
+  }
+  if (loopCloser_) snapshot.loopClosures = loopCloser_->closures();
+  return snapshot;
 }
 
 template <SensorConfiguration Sensor>

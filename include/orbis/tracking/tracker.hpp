@@ -47,6 +47,10 @@ struct TrackResult {
   bool newKeyFrame = false;
 };
 
+// What became of one keypoint of the last frame: matched to a map point, the seed of a new map
+// point (a new keyframe's or the first map's), rejected by motion-only BA, or left unmatched.
+enum class KeypointState : std::uint8_t { Unmatched, Matched, New, Outlier };
+
 // A tracked frame, stored relative to its reference keyframe.
 struct TrackedFrame {
   std::uint64_t index;
@@ -83,6 +87,11 @@ class Tracker {
   void setRelocaliser(std::function<bool(FrameT&)> relocalise) { relocalise_ = std::move(relocalise); }
   // A map was loaded: the first frames must relocalise in it rather than start a new map.
   void startLost() { state_ = TrackingState::Lost; }
+  // Off by default: when on, track() records each keypoint's KeypointState (for observers).
+  void setRecordKeypointStates(bool on) { recordKeypointStates_ = on; }
+  // The last frame's keypoint states (empty unless recording) and its local map. Tracking thread.
+  const std::vector<KeypointState>& keypointStates() const { return keypointStates_; }
+  const std::vector<MapPoint*>& localMapPoints() const { return localPoints_; }
 
  private:
   void computeBow(FrameT& f) const;
@@ -103,6 +112,7 @@ class Tracker {
   void createNewKeyFrame();
   // Runs motion-only BA on current_, then drops outliers; returns matches to map points kept.
   int optimiseAndDropOutliers();
+  void recordKeypointStates();
 
   Map& map_;
   const OrbVocabulary& vocabulary_;
@@ -120,6 +130,8 @@ class Tracker {
   int matchesInliers_ = 0;
   std::vector<KeyFrame*> localKeyFrames_;
   std::vector<MapPoint*> localPoints_;
+  bool recordKeypointStates_ = false;
+  std::vector<KeypointState> keypointStates_;
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
   std::vector<TrackedFrame> tracked_;
 };

@@ -69,6 +69,7 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
   std::lock_guard lock(map_.mutex());
   current_ = std::move(frame);
   current_.resetMatches();
+  if (recordKeypointStates_) keypointStates_.clear();
   TrackResult result;
 
   if (state_ == TrackingState::NotInitialised) {
@@ -76,6 +77,7 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
     if (bootstrap(current_)) {
       state_ = TrackingState::Ok;
       result.newKeyFrame = true;
+      if (recordKeypointStates_) recordKeypointStates();
     }
   } else {
     bool ok = false;
@@ -131,6 +133,7 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
         createNewKeyFrame();
         result.newKeyFrame = true;
       }
+      if (recordKeypointStates_) recordKeypointStates();
       for (std::size_t i = 0; i < current_.size(); ++i)
         if (current_.points[i] && current_.outlier[i]) {
           current_.points[i] = nullptr;
@@ -139,6 +142,7 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
     }
   }
 
+  if (recordKeypointStates_ && keypointStates_.empty()) keypointStates_.assign(current_.size(), KeypointState::Unmatched);
   result.state = state_;
   if (state_ == TrackingState::Ok) {
     result.Tcw = current_.Tcw;
@@ -147,6 +151,18 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
   }
   if (state_ != TrackingState::NotInitialised) last_ = std::move(current_);  // current_ is refilled next frame
   return result;
+}
+
+template <SensorConfiguration Sensor>
+void Tracker<Sensor>::recordKeypointStates() {
+  keypointStates_.resize(current_.size());
+  for (std::size_t i = 0; i < current_.size(); ++i) {
+    const MapPoint* p = current_.points[i];
+    if (!p) keypointStates_[i] = KeypointState::Unmatched;
+    else if (current_.outlier[i]) keypointStates_[i] = KeypointState::Outlier;
+    else if (p->firstFrame == current_.index) keypointStates_[i] = KeypointState::New;
+    else keypointStates_[i] = KeypointState::Matched;
+  }
 }
 
 template <SensorConfiguration Sensor>

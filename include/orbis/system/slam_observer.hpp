@@ -1,0 +1,76 @@
+// orbis/system/slam_observer.hpp — the seam a live display (orbis/viewer) watches SLAM through.
+//
+// Contract: a FrameObserver set on SlamCore is called on the tracking thread right after each
+// frame with a FrameSnapshot: copied data only (the frame's features are shared, immutable), so
+// the observer may keep it; it must return at once (copy into a slot, never wait). Without an
+// observer the tracker records nothing extra. A MapSnapshot is a copy of the map's keyframes,
+// points, graphs, loop closures and trajectory, taken by SlamCore::mapSnapshot() under the map
+// mutex; an observer takes one at its own (low) rate from its own thread. SlamObserver bundles
+// both for runDataset: attach() before the first frame, onFrame() per frame, detach() with the
+// final map after shutdown, before the system is destroyed.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "orbis/features/frame_features.hpp"
+#include "orbis/geometry/se3.hpp"
+#include "orbis/loop/loop_closer.hpp"
+#include "orbis/tracking/tracker.hpp"
+
+namespace orbis {
+
+struct FrameSnapshot {
+  std::uint64_t index = 0;
+  double timestamp = 0;
+  TrackingState state = TrackingState::NotInitialised;
+  SE3d Tcw;  // valid when state == Ok
+  int inliers = 0;
+  bool newKeyFrame = false;
+  std::shared_ptr<const FrameFeatures> features;  // keypoints (shared with the map, immutable)
+  std::vector<KeypointState> keypointStates;      // one per keypoint
+  std::vector<MapPointId> localMapPoints;         // the tracker's local map after this frame
+  double imageWidth = 0, imageHeight = 0;
+  double extractionMs = 0, trackingMs = 0;        // tracking includes inline mapping (deterministic)
+};
+
+struct KeyFrameSnapshot {
+  KeyFrameId id = 0;
+  std::uint64_t frameIndex = 0;
+  SE3d Twc;
+  std::int64_t parent = -1;  // spanning tree; -1 at the root
+  std::vector<KeyFrameId> covisibles, loopEdges;  // covisibles: weight >= kStrongCovisibility
+};
+
+struct MapPointSnapshot {
+  MapPointId id = 0;
+  Eigen::Vector3f position;
+  KeyFrameId firstKeyFrame = 0;
+};
+
+struct MapSnapshot {
+  static constexpr int kStrongCovisibility = 100;  // the edges ORB-SLAM2's viewer draws
+  std::vector<KeyFrameSnapshot> keyFrames;
+  std::vector<MapPointSnapshot> points;
+  std::vector<LoopClosureEvent> loopClosures;
+  std::vector<Eigen::Vector3f> trajectory;  // camera centres of the tracked frames
+  std::size_t frames = 0;
+};
+
+using FrameObserver = std::function<void(FrameSnapshot&&)>;
+using MapSnapshotSource = std::function<MapSnapshot()>;
+
+// Copies the good keyframes and points of `map`; the caller holds map.mutex().
+MapSnapshot snapshotOfMap(const Map& map);
+
+class SlamObserver {
+ public:
+  virtual ~SlamObserver() = default;
+  virtual void attach(MapSnapshotSource source) = 0;  // the source is valid until detach()
+  virtual void onFrame(FrameSnapshot&& frame) = 0;    // tracking thread: must not block
+  virtual void detach(MapSnapshot finalMap) = 0;
+};
+
+}  // namespace orbis

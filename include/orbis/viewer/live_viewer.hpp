@@ -1,0 +1,56 @@
+// orbis/viewer/live_viewer.hpp — a live 3-D view of SLAM in the browser.
+//
+// Contract: LiveViewer serves one page (three.js and the page are compiled into the library: it
+// works offline) on host:port, 127.0.0.1 by default, and streams the scene to it as server-sent
+// events of JSON. It is a SlamObserver (system/slam_observer.hpp): onFrame() only moves the
+// snapshot into a one-slot mailbox and returns; a publisher thread of its own turns the latest
+// frame into a message at most frameRateHz times a second and takes a map snapshot at mapRateHz,
+// and only while a browser is connected. Each browser gets the newest message of each kind: a
+// slow or vanished browser misses updates, never delays tracking. detach() or show() publish a
+// final map, which the page keeps showing until the viewer is destroyed. The constructor throws
+// orbis::Error when the port cannot be bound; the destructor stops the server and threads.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "orbis/system/slam_observer.hpp"
+
+namespace orbis {
+
+struct ViewerOptions {
+  std::string host = "127.0.0.1";
+  int port = 8080;
+  double frameRateHz = 15;  // frame messages (keypoints, pose, timing) per second, at most
+  double mapRateHz = 5;     // map snapshots per second, at most
+};
+
+// What the viewer did, for the overhead it adds: messages built and the CPU time of its
+// publisher thread (snapshots and JSON; the server's threads only copy bytes to sockets).
+struct ViewerStats {
+  std::size_t frameMessages = 0, mapMessages = 0, bytes = 0;
+  double publisherCpuSeconds = 0;
+};
+
+class LiveViewer final : public SlamObserver {
+ public:
+  explicit LiveViewer(ViewerOptions options = {});
+  ~LiveViewer() override;
+  LiveViewer(const LiveViewer&) = delete;
+  LiveViewer& operator=(const LiveViewer&) = delete;
+
+  std::string url() const;
+  ViewerStats stats() const;
+
+  void attach(MapSnapshotSource source) override;
+  void onFrame(FrameSnapshot&& frame) override;
+  void detach(MapSnapshot finalMap) override;
+  // A finished run or a saved map, without SLAM: serve this map (orbis view).
+  void show(MapSnapshot map);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace orbis

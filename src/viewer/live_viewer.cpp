@@ -1,0 +1,272 @@
+#include "orbis/viewer/live_viewer.hpp"
+
+#include <httplib.h>
+
+#include <array>
+#include <atomic>
+#include <optional>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <time.h>
+#include <unordered_set>
+
+#include "orbis/util/error.hpp"
+#include "scene_json.hpp"
+#include "web_assets.hpp"
+
+namespace orbis {
+
+using namespace viewer_detail;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// The newest message of each kind, numbered. Readers (one per browser) wait for a number they
+// have not sent yet; writers never wait for readers.
+class LatestMessages {
+ public:
+  enum Kind { kFrame, kMap, kKinds };
+
+  void publish(Kind kind, std::string message) {
+    auto shared = std::make_shared<const std::string>(std::move(message));
+    {
+      std::lock_guard lock(mutex_);
+      latest_[kind] = std::move(shared);
+      serial_[kind] = ++counter_;
+    }
+    changed_.notify_all();
+  }
+  // Waits up to `timeout` for a message newer than seen[kind]; returns it (or null) and updates seen.
+  using Seen = std::array<std::uint64_t, kKinds>;
+  std::shared_ptr<const std::string> next(Seen& seen, Kind& kind, std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex_);
+    auto fresh = [&] {
+      for (int k = 0; k < kKinds; ++k)
+        if (serial_[k] > seen[k]) return k;
+      return -1;
+    };
+    changed_.wait_for(lock, timeout, [&] { return fresh() >= 0 || closed_; });
+    const int k = fresh();
+    if (k < 0) return nullptr;
+    seen[k] = serial_[k];
+    kind = static_cast<Kind>(k);
+    return latest_[k];
+  }
+  void close() {
+    {
+      std::lock_guard lock(mutex_);
+      closed_ = true;
+    }
+    changed_.notify_all();
+  }
+  bool closed() const {
+    std::lock_guard lock(mutex_);
+    return closed_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::shared_ptr<const std::string> latest_[kKinds];
+  std::uint64_t serial_[kKinds] = {};
+  std::uint64_t counter_ = 0;
+  bool closed_ = false;
+};
+
+}  // namespace
+
+struct LiveViewer::Impl {
+  ViewerOptions options;
+  httplib::Server server;
+  std::thread serverThread, publisherThread;
+  LatestMessages messages;
+  std::atomic<int> clients{0};
+
+  std::mutex mutex;  // guards the fields below
+  std::condition_variable wake;
+  std::optional<FrameSnapshot> pendingFrame;
+  std::vector<MapPointId> localMap;  // of the newest frame
+  bool stopping = false;
+  std::mutex sourceMutex;  // held while a snapshot is taken: detach() waits for it, onFrame() never
+  MapSnapshotSource source;
+
+  std::mutex statsMutex;
+  ViewerStats stats;
+
+  void countMessage(bool map, std::size_t bytes);
+  void serveRoutes();
+  void streamEvents(httplib::Response& response);
+  void publishLoop();
+  void publishMap(const MapSnapshot& map, bool live);
+};
+
+void LiveViewer::Impl::serveRoutes() {
+  // First: the files' pattern below would match it too.
+  server.Get("/events", [this](const httplib::Request&, httplib::Response& response) { streamEvents(response); });
+  server.Get(R"(/(|[A-Za-z0-9_.\-]+))", [](const httplib::Request& request, httplib::Response& response) {
+    const WebAsset* asset = webAsset(request.path);
+    if (!asset) {
+      response.status = 404;
+      return;
+    }
+    // Straight from the embedded bytes, uncompressed: httplib would brotli-compress a body (850 kB
+    // of three.js) on every request, on the machine that runs SLAM.
+    response.set_content_provider(
+        asset->size, std::string(asset->contentType),
+        [asset](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+          return sink.write(reinterpret_cast<const char*>(asset->data) + offset, length);
+        },
+        [](bool) {});
+  });
+}
+
+void LiveViewer::Impl::streamEvents(httplib::Response& response) {
+  response.set_header("Cache-Control", "no-cache");
+  ++clients;
+  wake.notify_all();  // a new browser wants the current map now
+  auto seen = std::make_shared<LatestMessages::Seen>();
+  response.set_chunked_content_provider(
+      "text/event-stream",
+      [this, seen](std::size_t, httplib::DataSink& sink) {
+        LatestMessages::Kind kind{};
+        auto message = messages.next(*seen, kind, std::chrono::milliseconds(500));
+        if (messages.closed()) return false;
+        std::string event = message ? std::string("event: ") + (kind == LatestMessages::kFrame ? "frame" : "map") +
+                                          "\ndata: " + *message + "\n\n"
+                                    : std::string(": keep-alive\n\n");
+        return sink.write(event.data(), event.size());
+      },
+      [this](bool) { --clients; });
+}
+
+double threadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+void LiveViewer::Impl::countMessage(bool map, std::size_t bytes) {
+  std::lock_guard lock(statsMutex);
+  ++(map ? stats.mapMessages : stats.frameMessages);
+  stats.bytes += bytes;
+}
+
+void LiveViewer::Impl::publishMap(const MapSnapshot& map, bool live) {
+  std::unordered_set<MapPointId> local;
+  {
+    std::lock_guard lock(mutex);
+    local.insert(localMap.begin(), localMap.end());
+  }
+  std::string message = mapMessage(map, local, live);
+  countMessage(true, message.size());
+  messages.publish(LatestMessages::kMap, std::move(message));
+}
+
+void LiveViewer::Impl::publishLoop() {
+  const auto framePeriod = std::chrono::duration<double>(1.0 / options.frameRateHz);
+  const auto mapPeriod = std::chrono::duration<double>(1.0 / options.mapRateHz);
+  Clock::time_point lastFrame{}, lastMap{};
+  int clientsAtLastMap = 0;
+  std::unique_lock lock(mutex);
+  while (!stopping) {
+    wake.wait_for(lock, std::chrono::duration_cast<Clock::duration>(framePeriod));
+    if (stopping) break;
+    const Clock::time_point now = Clock::now();
+    if (clients == 0) continue;  // nobody watching: no work at all
+    if (pendingFrame && now - lastFrame >= framePeriod) {
+      FrameSnapshot frame = std::move(*pendingFrame);
+      pendingFrame.reset();
+      localMap = std::move(frame.localMapPoints);
+      lock.unlock();
+      std::string message = frameMessage(frame);
+      countMessage(false, message.size());
+      messages.publish(LatestMessages::kFrame, std::move(message));
+      lock.lock();
+      lastFrame = now;
+    }
+    const bool newClient = clients > clientsAtLastMap;
+    if (now - lastMap >= mapPeriod || newClient) {
+      lock.unlock();
+      {
+        std::lock_guard sourceLock(sourceMutex);
+        if (source) publishMap(source(), true);
+      }
+      lock.lock();
+      lastMap = now;
+    }
+    clientsAtLastMap = clients;
+    std::lock_guard statsLock(statsMutex);
+    stats.publisherCpuSeconds = threadCpuSeconds();
+  }
+}
+
+LiveViewer::LiveViewer(ViewerOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = std::move(options);
+  impl_->serveRoutes();
+  // httplib's default adds SO_REUSEPORT, which lets a second viewer share a busy port silently.
+  impl_->server.set_socket_options([](socket_t socket) {
+    int yes = 1;
+    setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
+  if (!impl_->server.bind_to_port(impl_->options.host.c_str(), impl_->options.port))
+    throw Error("viewer", "", "cannot listen on " + url() + " (port in use?)");
+  impl_->serverThread = std::thread([this] { impl_->server.listen_after_bind(); });
+  impl_->publisherThread = std::thread([this] { impl_->publishLoop(); });
+}
+
+LiveViewer::~LiveViewer() {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->wake.notify_all();
+  impl_->messages.close();
+  impl_->server.stop();
+  if (impl_->publisherThread.joinable()) impl_->publisherThread.join();
+  if (impl_->serverThread.joinable()) impl_->serverThread.join();
+}
+
+std::string LiveViewer::url() const {
+  return "http://" + impl_->options.host + ":" + std::to_string(impl_->options.port) + "/";
+}
+
+ViewerStats LiveViewer::stats() const {
+  std::lock_guard lock(impl_->statsMutex);
+  return impl_->stats;
+}
+
+void LiveViewer::attach(MapSnapshotSource source) {
+  std::lock_guard lock(impl_->sourceMutex);
+  impl_->source = std::move(source);
+}
+
+void LiveViewer::onFrame(FrameSnapshot&& frame) {
+  std::optional<FrameSnapshot> dropped;  // freed outside the lock
+  {
+    std::lock_guard lock(impl_->mutex);
+    dropped.swap(impl_->pendingFrame);
+    impl_->pendingFrame.emplace(std::move(frame));
+  }
+}
+
+void LiveViewer::detach(MapSnapshot finalMap) {
+  {
+    std::lock_guard sourceLock(impl_->sourceMutex);  // a snapshot being taken finishes first
+    impl_->source = nullptr;
+  }
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->pendingFrame) {
+      impl_->localMap = std::move(impl_->pendingFrame->localMapPoints);
+      impl_->messages.publish(LatestMessages::kFrame, frameMessage(*impl_->pendingFrame));
+      impl_->pendingFrame.reset();
+    }
+  }
+  impl_->publishMap(finalMap, false);
+}
+
+void LiveViewer::show(MapSnapshot map) { impl_->publishMap(map, false); }
+
+}  // namespace orbis
