@@ -160,8 +160,7 @@ std::optional<ChosenModel> estimateModel(std::span<const TwoViewMatch> matches, 
 // Only F's motion is refined: on a plane the epipolar (Sampson) cost is nearly flat along the
 // plane's two-fold ambiguity, while the homography, refitted on all its inliers, already pins
 // the motion down (the tests' tilted plane after a 0.6 m sideways motion, three seeds:
-// translation direction 0.2-1.0° off with the
-// refinement, 0.2-0.6° without).
+// translation direction 0.2-1.0° off with the refinement, 0.2-0.6° without).
 void refineFundamentalMotion(RankedMotions& ranked, std::span<const TwoViewMatch> matches,
                              const std::vector<bool>& inliers, const Eigen::Matrix3d& K) {
   const MotionHypothesis refined = refineWithRegating(ranked.best, matches, inliers, K);
