@@ -73,7 +73,13 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
 
   if (state_ == TrackingState::NotInitialised) {
     ScopedStage stage(timer_, "tracking: bootstrap");
-    if (bootstrap(current_)) {
+    bool started = false;
+    if constexpr (Sensor::kMetricScale) {
+      started = bootstrap(current_);
+    } else {
+      started = initialiseFromTwoViews(current_);
+    }
+    if (started) {
       state_ = TrackingState::Ok;
       result.newKeyFrame = true;
     }
