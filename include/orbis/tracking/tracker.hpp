@@ -14,7 +14,8 @@
 // to its reference keyframe, so trajectory() reflects later map corrections (loops, BA).
 // What differs by sensor is asked of the trait at compile time: the search windows (RGB-D's
 // depth from a sensor), the stereo checks, and which keypoints may be lifted from depth.
-// Bodies: tracker_impl.hpp; Tracker<Stereo> and Tracker<Rgbd> are compiled in src/tracking/.
+// Bodies: tracker_impl.hpp; Tracker<Stereo>, Tracker<Rgbd> and Tracker<Monocular> are compiled
+// in src/tracking/.
 // Monocular: initialisation only so far; tracking after it runs the shared path, but local
 // mapping, loop closing and Slam<Monocular> are not there yet.
 #pragma once
@@ -98,7 +99,8 @@ class Tracker {
 
  private:
   void computeBow(FrameT& f) const;
-  bool bootstrap(FrameT& f);
+  bool bootstrap(FrameT& f)
+    requires(Sensor::kMetricScale);
   // Monocular (monocular_initialisation_impl.hpp); constrained so that the explicit
   // instantiations for metric sensors do not compile them.
   bool initialiseFromTwoViews(FrameT& f)
@@ -159,4 +161,5 @@ class Tracker {
 namespace orbis {
 extern template class Tracker<Stereo>;
 extern template class Tracker<Rgbd>;
+extern template class Tracker<Monocular>;
 }  // namespace orbis

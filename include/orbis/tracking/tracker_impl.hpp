@@ -156,7 +156,9 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
 }
 
 template <SensorConfiguration Sensor>
-bool Tracker<Sensor>::bootstrap(FrameT& f) {
+bool Tracker<Sensor>::bootstrap(FrameT& f)
+  requires(Sensor::kMetricScale)
+{
   // ORB-SLAM2 starts on any frame with more than 500 keypoints; the map gets those with depth.
   if (static_cast<int>(f.size()) <= options_.minBootstrapFeatures) return false;
   f.Tcw = SE3d();
