@@ -64,8 +64,10 @@ struct TwoViewResult {
   double homographyRatio = 0;  // R_H = S_H / (S_H + S_F)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // R: frame 1 -> frame 2
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();   // t, unit norm when accepted
-  std::vector<Eigen::Vector3d> points;  // per match, in frame 1 (meaningful where triangulated)
-  std::vector<bool> triangulated;       // per match: passed every check with parallax
+  // Per match when accepted, empty when refused: the point in frame 1 (meaningful where
+  // triangulated) and whether it passed every check under enough parallax to trust its depth.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<bool> triangulated;
   int inliers = 0;        // matches inside the chosen model's χ² gates
   int goodPoints = 0;     // the best motion's points passing cheirality and reprojection
   int secondBestGood = 0; // the runner-up motion's
