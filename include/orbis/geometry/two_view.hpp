@@ -13,8 +13,9 @@
 // a clear winner with enough well-triangulated points and enough parallax; otherwise it
 // refuses with a TwoViewRefusal saying why (the caller waits for a later frame).
 // Motion convention: x₂ = R·x₁ + t (frame-1 coordinates to frame 2), ‖t‖ = 1; points are in
-// frame 1. The result depends only on the input and the generator's state (no clocks, no
-// threads whose order matters): the same seed gives the same bits. Nothing throws.
+// frame 1. The result depends only on the input and the generator's state (no clocks; F's
+// RANSAC may run on a second thread, whose timing changes nothing): the same seed gives the
+// same bits. Nothing throws (without a thread to be had, both RANSACs run on the caller's).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +57,7 @@ struct TwoViewOptions {
   double maxSecondBestRatio = 0.75;       // the runner-up must stay below this × the winner
   bool refitOnInliers = true;             // least squares on all inliers after RANSAC
   bool refineMotion = true;  // the winning motion refined on the Sampson distance of the inliers
+  bool parallelModels = true;  // F's RANSAC on a second thread (same result either way)
 };
 
 struct TwoViewResult {
