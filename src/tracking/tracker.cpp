@@ -27,5 +27,6 @@ SE3d worldPoseOf(const TrackedFrame& f) {
 
 template class Tracker<Stereo>;
 template class Tracker<Rgbd>;
+template class Tracker<Monocular>;
 
 }  // namespace orbis

@@ -57,7 +57,15 @@ done
 grep -q "serving the finished run" "$work/run.log" || { echo "the run did not finish"; exit 1; }
 
 # After the run: the page's scene against the report.
-scene=$(browse "$url" --dump-dom | sed -n 's/.*<pre id="scene-state">\([^<]*\)<.*/\1/p')
+# The DOM is dumped once the page's scripts have had their (virtual) time; on a loaded machine the
+# scene may not have arrived yet, so ask again a few times before judging.
+scene=""
+for attempt in 1 2 3 4 5; do
+  scene=$(browse "$url" --virtual-time-budget=$((2000 * attempt)) --dump-dom |
+    sed -n 's/.*<pre id="scene-state">\([^<]*\)<.*/\1/p')
+  [[ -n $scene && $scene == *keyframes* ]] && break
+  sleep 1
+done
 browse "$url" --screenshot="$work/viewer_final.png" >/dev/null
 echo "page: $scene"
 python3 - "$scene" "$work/out/report.json" <<'PY'

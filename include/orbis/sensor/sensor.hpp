@@ -17,6 +17,8 @@
 #include <opencv2/core.hpp>
 
 #include "orbis/camera/camera_model.hpp"
+#include "orbis/camera/distortion.hpp"
+#include "orbis/camera/pinhole.hpp"
 #include "orbis/camera/sensor_kind.hpp"
 #include "orbis/camera/stereo.hpp"
 #include "orbis/features/frame_features.hpp"
@@ -25,6 +27,11 @@
 #include "orbis/optim/robust_kernel.hpp"
 
 namespace orbis {
+
+struct MonocularInput {
+  double timestamp = 0;
+  cv::Mat image;  // 8-bit grey or BGR, as the lens took it (the builder undistorts keypoints)
+};
 
 struct StereoInput {
   double timestamp = 0;
@@ -112,6 +119,49 @@ struct Rgbd {
   };
 };
 
+// One camera, no depth: the map's scale is arbitrary (kMetricScale false), so the pipeline
+// initialises from two views (geometry/two_view.hpp) rather than one frame, and loops are
+// Sim(3). Keypoints are undistorted with the lens model (RadTan, zero = already undistorted).
+//
+// The initialisation budget (ORB-SLAM2: twice the features until the map exists, because the
+// two-view initialiser needs many matches between frames far apart): the builder keeps a second
+// extractor with twice the budget and uses it while initialising() is true. That state is set
+// by whoever knows when the map exists (the tracker's owner calls setInitialising(false) after
+// the two-view initialisation, true again after a reset), rather than "the first N frames":
+// initialisation takes as many frames as the motion needs (a pure rotation never initialises),
+// and a reset needs the larger budget again. A new builder starts initialising.
+struct Monocular {
+  using Camera = PinholeCamera<double>;
+  using Input = MonocularInput;
+  using RobustKernel = optim::HuberKernel;
+  static constexpr SensorKind kKind = SensorKind::Monocular;
+  static constexpr bool kMetricScale = false;
+  static constexpr bool kDepthFromSensor = false;
+  static constexpr int kInitialisationBudgetFactor = 2;
+
+  class FeatureBuilder {
+   public:
+    FeatureBuilder(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens = {})
+        : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {}
+    FrameFeatures build(const Input& in) {
+      return extractMonocular(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, camera_, lens_);
+    }
+    void setInitialising(bool initialising) { isInitialising_ = initialising; }
+    bool initialising() const { return isInitialising_; }
+
+   private:
+    static OrbParams initialisationParams(OrbParams orb) {
+      orb.features *= kInitialisationBudgetFactor;
+      return orb;
+    }
+    Camera camera_;
+    RadTanDistortion<double> lens_;
+    OrbExtractor trackingExtractor_, initialisationExtractor_;
+    bool isInitialising_ = true;
+  };
+};
+
+static_assert(SensorConfiguration<Monocular>);
 static_assert(SensorConfiguration<Stereo>);
 static_assert(SensorConfiguration<Rgbd>);
 

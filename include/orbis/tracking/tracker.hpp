@@ -2,7 +2,11 @@
 // sensor configuration.
 //
 // Contract: track(frame) estimates the frame's camera pose against the map and decides whether
-// it becomes a keyframe. On the first frame with enough depth it bootstraps the map (§III-B).
+// it becomes a keyframe. On the first frame with enough depth it bootstraps the map (§III-B);
+// a sensor without metric scale (monocular) initialises from two views instead
+// (monocular_initialisation_impl.hpp): a reference frame, windowed matches in later frames, the
+// two-view initialiser (geometry/two_view.hpp), two keyframes, BA, median depth scaled to 1; a
+// refused attempt says why (initialisationRefusal()) and is retried with the next frame.
 // Then: constant-velocity prediction with search by projection, falling back to bag-of-words
 // matching against the reference keyframe; local-map tracking; motion-only BA with outlier
 // rejection; the ORB-SLAM2 keyframe rule including the close-point rule (τt, τc). It holds
@@ -10,14 +14,19 @@
 // to its reference keyframe, so trajectory() reflects later map corrections (loops, BA).
 // What differs by sensor is asked of the trait at compile time: the search windows (RGB-D's
 // depth from a sensor), the stereo checks, and which keypoints may be lifted from depth.
-// Bodies: tracker_impl.hpp; Tracker<Stereo> and Tracker<Rgbd> are compiled in src/tracking/.
+// Bodies: tracker_impl.hpp; Tracker<Stereo>, Tracker<Rgbd> and Tracker<Monocular> are compiled
+// in src/tracking/.
+// Monocular: initialisation only so far; tracking after it runs the shared path, but local
+// mapping, loop closing and Slam<Monocular> are not there yet.
 #pragma once
 
 #include <functional>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include "orbis/bow/vocabulary.hpp"
+#include "orbis/geometry/two_view.hpp"
 #include "orbis/map/frame.hpp"
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
@@ -38,6 +47,11 @@ struct TrackerOptions {
   int minBootstrapFeatures = 500;      // keypoints needed to start the map (ORB-SLAM2)
   int bowLevelsUp = 4;                 // vocabulary level of the FeatureVector grouping
   bool localisationOnly = false;       // no keyframes, visual-odometry points from depth
+  // Monocular two-view initialisation (ORB-SLAM's MonocularInitialization).
+  int minInitialisationKeypoints = 100;  // a reference frame needs more keypoints than this
+  int minInitialisationMatches = 100;    // windowed matches below this drop the reference
+  float initialisationWindow = 100;      // px around the previous match (ORB-SLAM's)
+  unsigned initialisationSeed = 5489;    // the two-view RANSAC's generator (deterministic runs)
 };
 
 struct TrackResult {
@@ -67,9 +81,6 @@ class Tracker {
  public:
   using Camera = typename Sensor::Camera;
   using FrameT = Frame<Camera>;
-  static_assert(Sensor::kMetricScale,
-                "the tracker bootstraps the map from one frame's depth; two-view (monocular) "
-                "initialisation is not available yet");
 
   Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMappingControl* mapper, TrackerOptions options,
           StageTimer* timer = nullptr);
@@ -77,6 +88,8 @@ class Tracker {
   TrackResult track(FrameT frame);
 
   TrackingState state() const { return state_; }
+  // Why the last monocular initialisation attempt was refused (None before any attempt).
+  TwoViewRefusal initialisationRefusal() const { return initialisationRefusal_; }
   void setLocalisationOnly(bool on) { options_.localisationOnly = on; }
   bool localisationOnly() const { return options_.localisationOnly; }
   // Every tracked frame, by index. Read with the map mutex held (poses move with the map).
@@ -95,7 +108,17 @@ class Tracker {
 
  private:
   void computeBow(FrameT& f) const;
-  bool bootstrap(FrameT& f);
+  bool bootstrap(FrameT& f)
+    requires(Sensor::kMetricScale);
+  // Monocular (monocular_initialisation_impl.hpp); constrained so that the explicit
+  // instantiations for metric sensors do not compile them.
+  bool initialiseFromTwoViews(FrameT& f)
+    requires(!Sensor::kMetricScale);
+  bool createInitialMap(FrameT& f, const std::vector<std::pair<std::size_t, std::size_t>>& pairs,
+                        const TwoViewResult& twoView)
+    requires(!Sensor::kMetricScale);
+  void startMap(KeyFrame* first, KeyFrame* second, FrameT& f)
+    requires(!Sensor::kMetricScale);
   bool trackReferenceKeyFrame();
   // Projects the last frame's matches through `motion` (current from last) and optimises.
   bool trackWithMotionModel(const SE3d& motion);
@@ -134,13 +157,21 @@ class Tracker {
   std::vector<KeypointState> keypointStates_;
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
   std::vector<TrackedFrame> tracked_;
+
+  // Monocular initialisation: the reference frame, where its keypoints were last matched.
+  std::optional<FrameT> initialReference_;
+  std::vector<Eigen::Vector2f> initialPredicted_;
+  std::mt19937 initialisationRng_{options_.initialisationSeed};
+  TwoViewRefusal initialisationRefusal_ = TwoViewRefusal::None;
 };
 
 }  // namespace orbis
 
 #include "orbis/tracking/tracker_impl.hpp"
+#include "orbis/tracking/monocular_initialisation_impl.hpp"
 
 namespace orbis {
 extern template class Tracker<Stereo>;
 extern template class Tracker<Rgbd>;
+extern template class Tracker<Monocular>;
 }  // namespace orbis

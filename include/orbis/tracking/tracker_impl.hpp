@@ -74,7 +74,13 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
 
   if (state_ == TrackingState::NotInitialised) {
     ScopedStage stage(timer_, "tracking: bootstrap");
-    if (bootstrap(current_)) {
+    bool started = false;
+    if constexpr (Sensor::kMetricScale) {
+      started = bootstrap(current_);
+    } else {
+      started = initialiseFromTwoViews(current_);
+    }
+    if (started) {
       state_ = TrackingState::Ok;
       result.newKeyFrame = true;
       if (recordKeypointStates_) recordKeypointStates();
@@ -166,7 +172,9 @@ void Tracker<Sensor>::recordKeypointStates() {
 }
 
 template <SensorConfiguration Sensor>
-bool Tracker<Sensor>::bootstrap(FrameT& f) {
+bool Tracker<Sensor>::bootstrap(FrameT& f)
+  requires(Sensor::kMetricScale)
+{
   // ORB-SLAM2 starts on any frame with more than 500 keypoints; the map gets those with depth.
   if (static_cast<int>(f.size()) <= options_.minBootstrapFeatures) return false;
   f.Tcw = SE3d();
