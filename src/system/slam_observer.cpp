@@ -1,4 +1,4 @@
-#include "orbis/system/slam_observer.hpp"
+#include "orbis/viewer/slam_observer.hpp"
 
 #include "orbis/map/map.hpp"
 

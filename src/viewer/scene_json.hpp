@@ -12,7 +12,7 @@
 #include <string>
 #include <unordered_set>
 
-#include "orbis/system/slam_observer.hpp"
+#include "orbis/viewer/slam_observer.hpp"
 
 namespace orbis::viewer_detail {
 

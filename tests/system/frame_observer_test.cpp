@@ -1,4 +1,4 @@
-// The observer seam a live viewer uses (system/slam_observer.hpp): a FrameObserver sees every
+// The observer seam a live viewer uses (viewer/slam_observer.hpp): a FrameObserver sees every
 // frame with its keypoint states, mapSnapshot() copies the map, and observing changes nothing.
 #include <gtest/gtest.h>
 

@@ -214,7 +214,7 @@ void LoopCloser<Sensor>::runFullBundleAdjustment() {
   FullBundleAdjustmentResult result;
   {
     ScopedStage stage(timer_, "loop: full BA");
-    result = fullBundleAdjustment<Sensor>(camera_, map_, options_.fullBundleAdjustmentIterations, &abortFullBa_);
+    result = fullBundleAdjustment<typename Sensor::RobustKernel>(camera_, map_, options_.fullBundleAdjustmentIterations, &abortFullBa_);
   }
   if (result.aborted || abortFullBa_) return;
   pauseMapping();

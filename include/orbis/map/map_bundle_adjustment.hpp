@@ -8,7 +8,7 @@
 // lock, skipping objects that went bad meanwhile. fullBundleAdjustment does the same over every
 // keyframe and point, the origin fixed, and returns the optimised values without writing them:
 // the loop closer merges them through the spanning tree. Both run on the sensor's camera model and
-// robust kernel (Sensor::Camera, Sensor::RobustKernel): depth observations of an RGB-D sensor as
+// robust kernel (callers pass Sensor::Camera and Sensor::RobustKernel): depth observations of an RGB-D sensor as
 // a whitened disparity, of a stereo pair as (uL, v, uR). Bodies: map_bundle_adjustment_impl.hpp.
 #pragma once
 
@@ -16,7 +16,8 @@
 #include <map>
 
 #include "orbis/map/map.hpp"
-#include "orbis/sensor/sensor.hpp"
+#include "orbis/camera/camera_model.hpp"
+#include "orbis/optim/robust_kernel.hpp"
 
 namespace orbis {
 
@@ -25,8 +26,8 @@ struct LocalBundleAdjustmentStats {
   bool aborted = false;
 };
 
-template <SensorConfiguration Sensor>
-LocalBundleAdjustmentStats localBundleAdjustment(const typename Sensor::Camera& camera, Map& map, KeyFrame* kf,
+template <optim::RobustKernel Kernel, CameraModel Camera>
+LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map, KeyFrame* kf,
                                                  std::atomic<bool>* abort);
 
 struct FullBundleAdjustmentResult {
@@ -35,8 +36,8 @@ struct FullBundleAdjustmentResult {
   bool aborted = false;
 };
 
-template <SensorConfiguration Sensor>
-FullBundleAdjustmentResult fullBundleAdjustment(const typename Sensor::Camera& camera, Map& map, int iterations,
+template <optim::RobustKernel Kernel, CameraModel Camera>
+FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
                                                 std::atomic<bool>* abort);
 
 }  // namespace orbis

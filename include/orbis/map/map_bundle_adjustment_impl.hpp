@@ -55,17 +55,15 @@ inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, con
   }
 }
 
-template <SensorConfiguration Sensor>
-optim::BundleAdjustmentResult solve(const typename Sensor::Camera& camera, BaSnapshot& s,
-                                    const optim::BundleAdjustmentOptions& options) {
-  return optim::bundleAdjustment<typename Sensor::RobustKernel>(camera, s.poses, s.poseFixed, s.positions,
-                                                                s.observations, options);
+template <optim::RobustKernel Kernel, CameraModel Camera>
+optim::BundleAdjustmentResult solve(const Camera& camera, BaSnapshot& s, const optim::BundleAdjustmentOptions& options) {
+  return optim::bundleAdjustment<Kernel>(camera, s.poses, s.poseFixed, s.positions, s.observations, options);
 }
 
 }  // namespace map_ba_detail
 
-template <SensorConfiguration Sensor>
-LocalBundleAdjustmentStats localBundleAdjustment(const typename Sensor::Camera& camera, Map& map, KeyFrame* kf,
+template <optim::RobustKernel Kernel, CameraModel Camera>
+LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map, KeyFrame* kf,
                                                  std::atomic<bool>* abort) {
   using namespace map_ba_detail;
   LocalBundleAdjustmentStats stats;
@@ -94,7 +92,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(const typename Sensor::Camera& 
   options.iterations = 5;
   options.refineIterations = 10;
   options.abortFlag = abort;
-  const optim::BundleAdjustmentResult result = solve<Sensor>(camera, s, options);
+  const optim::BundleAdjustmentResult result = solve<Kernel>(camera, s, options);
   stats.aborted = result.robustPass.termination == optim::Termination::Aborted;
 
   std::lock_guard lock(map.mutex());
@@ -121,8 +119,8 @@ LocalBundleAdjustmentStats localBundleAdjustment(const typename Sensor::Camera& 
   return stats;
 }
 
-template <SensorConfiguration Sensor>
-FullBundleAdjustmentResult fullBundleAdjustment(const typename Sensor::Camera& camera, Map& map, int iterations,
+template <optim::RobustKernel Kernel, CameraModel Camera>
+FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
                                                 std::atomic<bool>* abort) {
   using namespace map_ba_detail;
   FullBundleAdjustmentResult result;
@@ -138,7 +136,7 @@ FullBundleAdjustmentResult fullBundleAdjustment(const typename Sensor::Camera& c
   options.iterations = iterations;
   options.refineIterations = 0;
   options.abortFlag = abort;
-  const optim::BundleAdjustmentResult solved = solve<Sensor>(camera, s, options);
+  const optim::BundleAdjustmentResult solved = solve<Kernel>(camera, s, options);
   result.aborted = solved.robustPass.termination == optim::Termination::Aborted || (abort && abort->load());
   for (std::size_t i = 0; i < s.keyFrames.size(); ++i) result.keyFramePoses[s.keyFrames[i]->id] = s.poses[i];
   for (std::size_t i = 0; i < s.points.size(); ++i) result.pointPositions[s.points[i]->id] = s.positions[i];

@@ -146,7 +146,7 @@ bool LocalMapper<Sensor>::processOne() {
       {
         ScopedStage stage(timer_, "mapping: local BA");
         std::atomic<bool>* abort = options_.threaded ? &abortBA_ : nullptr;
-        localBundleAdjustment<Sensor>(camera_, map_, kf, abort);
+        localBundleAdjustment<typename Sensor::RobustKernel>(camera_, map_, kf, abort);
       }
       if (options_.cullKeyFrames) {
         ScopedStage stage(timer_, "mapping: keyframe culling");

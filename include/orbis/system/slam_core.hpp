@@ -19,7 +19,7 @@
 #include "orbis/map/map.hpp"
 #include "orbis/mapping/local_mapper.hpp"
 #include "orbis/sensor/sensor.hpp"
-#include "orbis/system/slam_observer.hpp"
+#include "orbis/viewer/slam_observer.hpp"
 #include "orbis/tracking/relocaliser.hpp"
 #include "orbis/tracking/tracker.hpp"
 #include "orbis/util/timing.hpp"

@@ -2,7 +2,7 @@
 //
 // Contract: LiveViewer serves one page (three.js and the page are compiled into the library: it
 // works offline) on host:port, 127.0.0.1 by default, and streams the scene to it as server-sent
-// events of JSON. It is a SlamObserver (system/slam_observer.hpp): onFrame() only moves the
+// events of JSON. It is a SlamObserver (viewer/slam_observer.hpp): onFrame() only moves the
 // snapshot into a one-slot mailbox and returns; a publisher thread of its own turns the latest
 // frame into a message at most frameRateHz times a second and takes a map snapshot at mapRateHz,
 // and only while a browser is connected. Each browser gets the newest message of each kind: a
@@ -14,7 +14,7 @@
 #include <memory>
 #include <string>
 
-#include "orbis/system/slam_observer.hpp"
+#include "orbis/viewer/slam_observer.hpp"
 
 namespace orbis {
 

@@ -1,4 +1,5 @@
-// orbis/system/slam_observer.hpp — the seam a live display (orbis/viewer) watches SLAM through.
+// orbis/viewer/slam_observer.hpp — the seam a live display watches SLAM through: owned by the viewer,
+// filled by the system (SlamCore includes it; the viewer never includes the system).
 //
 // Contract: a FrameObserver set on SlamCore is called on the tracking thread right after each
 // frame with a FrameSnapshot: copied data only (the frame's features are shared, immutable), so
