@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "orbis/util/error.hpp"
+#include "frame_image.hpp"
 #include "scene_json.hpp"
 #include "web_assets.hpp"
 
@@ -35,8 +36,15 @@ class LatestMessages {
       std::lock_guard lock(mutex_);
       latest_[kind] = std::move(shared);
       serial_[kind] = ++counter_;
+      taken_[kind] = false;
     }
     changed_.notify_all();
+  }
+  // Whether a browser has been handed the newest message of this kind (true before the first):
+  // while it has not, building a newer one would only be thrown away.
+  bool taken(Kind kind) const {
+    std::lock_guard lock(mutex_);
+    return taken_[kind];
   }
   // Waits up to `timeout` for a message newer than seen[kind]; returns it (or null) and updates seen.
   using Seen = std::array<std::uint64_t, kKinds>;
@@ -51,6 +59,7 @@ class LatestMessages {
     const int k = fresh();
     if (k < 0) return nullptr;
     seen[k] = serial_[k];
+    taken_[k] = true;
     kind = static_cast<Kind>(k);
     return latest_[k];
   }
@@ -71,6 +80,7 @@ class LatestMessages {
   std::condition_variable changed_;
   std::shared_ptr<const std::string> latest_[kKinds];
   std::uint64_t serial_[kKinds] = {};
+  bool taken_[kKinds] = {true, true};
   std::uint64_t counter_ = 0;
   bool closed_ = false;
 };
@@ -100,7 +110,15 @@ struct LiveViewer::Impl {
   void streamEvents(httplib::Response& response);
   void publishLoop();
   void publishMap(const MapSnapshot& map, bool live);
+  std::string frameMessageOf(FrameSnapshot& frame) const;
 };
+
+// The frame's message with its image; the image reference is let go here, on this thread.
+std::string LiveViewer::Impl::frameMessageOf(FrameSnapshot& frame) const {
+  const std::string jpeg = jpegBase64(frame.image, options.imageMaxWidth, options.jpegQuality);
+  frame.image.release();
+  return frameMessage(frame, jpeg);
+}
 
 void LiveViewer::Impl::serveRoutes() {
   // First: the files' pattern below would match it too.
@@ -175,12 +193,14 @@ void LiveViewer::Impl::publishLoop() {
     if (stopping) break;
     const Clock::time_point now = Clock::now();
     if (clients == 0) continue;  // nobody watching: no work at all
-    if (pendingFrame && now - lastFrame >= framePeriod) {
+    // A browser that has not yet been sent the last frame is slow: its frames wait (and are
+    // replaced by newer ones) instead of being encoded for nothing.
+    if (pendingFrame && now - lastFrame >= framePeriod && messages.taken(LatestMessages::kFrame)) {
       FrameSnapshot frame = std::move(*pendingFrame);
       pendingFrame.reset();
       localMap = std::move(frame.localMapPoints);
       lock.unlock();
-      std::string message = frameMessage(frame);
+      std::string message = frameMessageOf(frame);
       countMessage(false, message.size());
       messages.publish(LatestMessages::kFrame, std::move(message));
       lock.lock();
@@ -260,7 +280,7 @@ void LiveViewer::detach(MapSnapshot finalMap) {
     std::lock_guard lock(impl_->mutex);
     if (impl_->pendingFrame) {
       impl_->localMap = std::move(impl_->pendingFrame->localMapPoints);
-      impl_->messages.publish(LatestMessages::kFrame, frameMessage(*impl_->pendingFrame));
+      impl_->messages.publish(LatestMessages::kFrame, impl_->frameMessageOf(*impl_->pendingFrame));
       impl_->pendingFrame.reset();
     }
   }

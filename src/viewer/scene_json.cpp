@@ -83,7 +83,7 @@ void writePoints(JsonOut& out, const MapSnapshot& map, const std::unordered_set<
 
 }  // namespace
 
-std::string frameMessage(const FrameSnapshot& frame) {
+std::string frameMessage(const FrameSnapshot& frame, std::string_view jpegBase64) {
   JsonOut out;
   out.raw("{").key("index").integer(static_cast<long long>(frame.index)).key("t").number(frame.timestamp, 6);
   out.key("state").raw("\"").raw(toString(frame.state)).raw("\"");
@@ -102,7 +102,10 @@ std::string frameMessage(const FrameSnapshot& frame) {
       out.separator().number(keypoints[i].u, 1).raw(",").number(keypoints[i].v, 1).raw(",").integer(state);
     }
   }
-  return out.raw("]}").take();
+  out.raw("]").key("image");
+  if (jpegBase64.empty()) out.raw("null");
+  else out.raw("\"").raw(jpegBase64).raw("\"");  // base64 needs no JSON escaping
+  return out.raw("}").take();
 }
 
 std::string mapMessage(const MapSnapshot& map, const std::unordered_set<MapPointId>& localMap, bool live) {

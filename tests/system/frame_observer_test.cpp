@@ -1,5 +1,6 @@
 // The observer seam a live viewer uses (viewer/slam_observer.hpp): a FrameObserver sees every
-// frame with its keypoint states, mapSnapshot() copies the map, and observing changes nothing.
+// frame with its keypoint states and its input image (shared), mapSnapshot() copies the map, and
+// observing changes nothing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@ struct ObservedRun {
   Trajectory trajectory;
   SlamStats stats;
   std::vector<FrameSnapshot> frames;
+  std::vector<const uchar*> inputPixels;  // where each input image's pixels were
   MapSnapshot map;
 };
 
@@ -36,8 +38,11 @@ ObservedRun runRendered(bool observe) {
   Slam<Rgbd> slam(test::syntheticCamera<Rgbd>(seq, options.baseline), orb, test::sharedVocabulary(), slamOptions);
   ObservedRun run;
   if (observe) slam.setFrameObserver([&run](FrameSnapshot&& frame) { run.frames.push_back(std::move(frame)); });
-  for (int i = 0; i < seq.size(); ++i)
-    slam.track(test::syntheticInput<Rgbd>(seq.render(i, false, true), seq.timestamp(i)));
+  for (int i = 0; i < seq.size(); ++i) {
+    const auto input = test::syntheticInput<Rgbd>(seq.render(i, false, true), seq.timestamp(i));
+    run.inputPixels.push_back(input.image.data);
+    slam.track(input);
+  }
   slam.shutdown();
   run.trajectory = slam.trajectory();
   run.stats = slam.stats();
@@ -63,6 +68,10 @@ TEST(FrameObserver, SeesEveryFrameWithKeypointStatesAndChangesNothing) {
     else if (f.state == TrackingState::Ok) EXPECT_GT(count(KeypointState::Matched), 20) << "frame " << i;
     if (f.newKeyFrame && i > 0) EXPECT_GT(count(KeypointState::New), 0) << "frame " << i;
     if (f.state == TrackingState::Ok) EXPECT_FALSE(f.localMapPoints.empty());
+    // The input image itself, shared, not copied on the tracking thread.
+    EXPECT_EQ(f.image.data, observed.inputPixels[i]) << "frame " << i;
+    EXPECT_EQ(f.imageWidth, 320);
+    EXPECT_EQ(f.imageHeight, 240);
   }
 }
 

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The live viewer as a person uses it: `orbis run --viewer` on a rendered loop (closed at frame
 # ~119, then 120 frames more over known ground), the page loaded in headless Chromium while SLAM
-# runs — its screenshot is taken once the page has seen the loop closure, or at the latest when
-# the run ends — and after it has finished; the scene the page holds (window.orbisScene,
-# mirrored in #scene-state) must match the run's report.json. Screenshots:
+# runs — its screenshot is taken once the page has seen the loop closure (page_probe.py) — and
+# after it has finished; the scene the page holds (window.orbisScene,
+# mirrored in #scene-state) must match the run's report.json, and the camera image must have
+# been drawn. Screenshots:
 # WORK_DIR/viewer_live.png and WORK_DIR/viewer_final.png.
 #
 # Usage: viewer_page_test.sh ORBIS_BINARY WORK_DIR
@@ -23,13 +24,6 @@ if [[ ! -f $work/synth/rgb.txt ]]; then
     --threads 2 >/dev/null
 fi
 
-browse() {  # browse URL ARGS...: headless Chromium, bounded in time, its chatter dropped
-  local url=$1
-  shift
-  timeout 90 "$chromium" --headless --disable-gpu --no-sandbox --hide-scrollbars --window-size=1400,800 \
-    --user-data-dir="$work/chromium-profile" "$@" "$url" 2>/dev/null
-}
-
 # A free port: orbis refuses a busy one at once.
 pid=""
 for port in 18751 18752 18753 18754 18755; do
@@ -46,9 +40,14 @@ done
 trap 'kill -TERM $pid 2>/dev/null || true; wait $pid 2>/dev/null || true' EXIT
 url="http://127.0.0.1:$port/"
 
-# While SLAM runs: the page closes its stream (and Chromium takes the picture) once a loop closure
-# has arrived, or when the run is over if the page connected that late.
-browse "$url?loops=1" --screenshot="$work/viewer_live.png" >/dev/null
+# While SLAM runs: the page closes its stream once the map holding a loop closure has arrived
+# (?loops=1), which freezes it at that moment; the probe waits for it over the DevTools protocol
+# and takes the screenshot. The page must have seen the closure live, during the run.
+probe=$(dirname "$0")/page_probe.py
+live=$(python3 "$probe" "$url?loops=1&view=top" --until "window.orbisScene.loopClosures >= 1" \
+  --screenshot "$work/viewer_live.png" --timeout 240 --chromium "$chromium") || { echo "no loop closure on the page: $live"; exit 1; }
+echo "page at the loop closure: $live"
+python3 -c "import json,sys; s=json.loads(sys.argv[1]); assert s['live'] is True and s['images'] >= 1, s" "$live"
 for _ in $(seq 600); do
   grep -q "serving the finished run" "$work/run.log" && break
   kill -0 "$pid" 2>/dev/null || { echo "orbis run ended early:"; cat "$work/run.log"; exit 1; }
@@ -56,17 +55,9 @@ for _ in $(seq 600); do
 done
 grep -q "serving the finished run" "$work/run.log" || { echo "the run did not finish"; exit 1; }
 
-# After the run: the page's scene against the report.
-# The DOM is dumped once the page's scripts have had their (virtual) time; on a loaded machine the
-# scene may not have arrived yet, so ask again a few times before judging.
-scene=""
-for attempt in 1 2 3 4 5; do
-  scene=$(browse "$url" --virtual-time-budget=$((2000 * attempt)) --dump-dom |
-    sed -n 's/.*<pre id="scene-state">\([^<]*\)<.*/\1/p')
-  [[ -n $scene && $scene == *keyframes* ]] && break
-  sleep 1
-done
-browse "$url" --screenshot="$work/viewer_final.png" >/dev/null
+# After the run: the page's scene against the report, once the final map and image are shown.
+scene=$(python3 "$probe" "$url" --until "window.orbisScene.live === false && window.orbisScene.images >= 1" \
+  --screenshot "$work/viewer_final.png" --timeout 60 --chromium "$chromium") || { echo "final page: $scene"; exit 1; }
 echo "page: $scene"
 python3 - "$scene" "$work/out/report.json" <<'PY'
 import json, sys
@@ -79,6 +70,7 @@ assert scene["points"] == report["map_points"], "map points differ"
 assert scene["frames"] == report["frames"], "frames differ"
 assert scene["live"] is False, "the page should show the finished run"
 assert scene["loopClosures"] >= 1, "the rendered loop should have closed"
+assert scene["images"] >= 1, "the page should show the camera image"
 PY
 for shot in viewer_live viewer_final; do
   [[ -s $work/$shot.png ]] || { echo "no screenshot $shot.png"; exit 1; }

@@ -40,7 +40,7 @@ class Slam {
       features = std::make_shared<const FrameFeatures>(builder_.build(input));
       if (core_.observesFrames()) extractionMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     }
-    return core_.track(std::move(features), input.timestamp, extractionMs);
+    return core_.track(std::move(features), input.timestamp, extractionMs, observedImage(input));
   }
 
   void shutdown() { core_.shutdown(); }
@@ -58,6 +58,12 @@ class Slam {
   const SlamCore<Sensor>& core() const { return core_; }
 
  private:
+  // The image a frame observer is shown: the left one of a stereo pair.
+  static const cv::Mat& observedImage(const Input& input) {
+    if constexpr (requires { input.left; }) return input.left;
+    else return input.image;
+  }
+
   typename Sensor::FeatureBuilder builder_;
   SlamCore<Sensor> core_;
 };

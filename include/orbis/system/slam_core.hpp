@@ -51,8 +51,10 @@ class SlamCore {
   SlamCore(const SlamCore&) = delete;
   SlamCore& operator=(const SlamCore&) = delete;
 
-  // extractionMs: the caller's feature extraction time, passed on to the frame observer.
-  TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp, double extractionMs = 0);
+  // extractionMs and image (the frame's input image, shared, never read here): passed on to the
+  // frame observer, if one is set.
+  TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp, double extractionMs = 0,
+                    const cv::Mat& image = cv::Mat());
   void shutdown();
 
   Trajectory trajectory() const;          // every tracked frame, camera-to-world

@@ -63,7 +63,7 @@ void SlamCore<Sensor>::shutdown() {
 
 template <SensorConfiguration Sensor>
 TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> features, double timestamp,
-                                    double extractionMs) {
+                                    double extractionMs, const cv::Mat& image) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point start = frameObserver_ ? Clock::now() : Clock::time_point{};
   std::shared_ptr<const FrameFeatures> observed = frameObserver_ ? features : nullptr;
@@ -98,8 +98,9 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     snapshot.Tcw = result.Tcw;
     snapshot.inliers = result.inliers;
     snapshot.newKeyFrame = result.newKeyFrame;
-    snapshot.imageWidth = intrinsics_.maxX;
-    snapshot.imageHeight = intrinsics_.maxY;
+    snapshot.image = image;  // a reference: the viewer's own thread scales and encodes it, if at all
+    snapshot.imageWidth = image.empty() ? intrinsics_.maxX : image.cols;
+    snapshot.imageHeight = image.empty() ? intrinsics_.maxY : image.rows;
     snapshot.features = std::move(observed);
     snapshot.keypointStates = tracker_->keypointStates();
     snapshot.localMapPoints.reserve(tracker_->localMapPoints().size());

@@ -4,8 +4,10 @@
 // works offline) on host:port, 127.0.0.1 by default, and streams the scene to it as server-sent
 // events of JSON. It is a SlamObserver (viewer/slam_observer.hpp): onFrame() only moves the
 // snapshot into a one-slot mailbox and returns; a publisher thread of its own turns the latest
-// frame into a message at most frameRateHz times a second and takes a map snapshot at mapRateHz,
-// and only while a browser is connected. Each browser gets the newest message of each kind: a
+// frame into a message at most frameRateHz times a second (with its image scaled down and JPEG-
+// encoded there, never on the tracking thread; the frames in between are dropped, and no new
+// frame is encoded while no browser has been sent the previous one) and takes a map snapshot at
+// mapRateHz, and only while a browser is connected. Each browser gets the newest message of each kind: a
 // slow or vanished browser misses updates, never delays tracking. detach() or show() publish a
 // final map, which the page keeps showing until the viewer is destroyed. The constructor throws
 // orbis::Error when the port cannot be bound; the destructor stops the server and threads.
@@ -23,6 +25,8 @@ struct ViewerOptions {
   int port = 8080;
   double frameRateHz = 15;  // frame messages (keypoints, pose, timing) per second, at most
   double mapRateHz = 5;     // map snapshots per second, at most
+  int imageMaxWidth = 320;  // the camera image, scaled down to this width as JPEG; 0: no image
+  int jpegQuality = 70;
 };
 
 // What the viewer did, for the overhead it adds: messages built and the CPU time of its

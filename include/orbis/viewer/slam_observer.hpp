@@ -3,7 +3,10 @@
 //
 // Contract: a FrameObserver set on SlamCore is called on the tracking thread right after each
 // frame with a FrameSnapshot: copied data only (the frame's features are shared, immutable), so
-// the observer may keep it; it must return at once (copy into a slot, never wait). Without an
+// the observer may keep it; it must return at once (copy into a slot, never wait). Its image is
+// the input image itself, shared (a cv::Mat header, not a copy of the pixels): whoever feeds
+// Slam::track a frame must not write into that frame's pixels afterwards while an observer is
+// set (hand each frame its own buffer, as the dataset readers do, or pass a clone). Without an
 // observer the tracker records nothing extra. A MapSnapshot is a copy of the map's keyframes,
 // points, graphs, loop closures and trajectory, taken by SlamCore::mapSnapshot() under the map
 // mutex; an observer takes one at its own (low) rate from its own thread. SlamObserver bundles
@@ -15,6 +18,8 @@
 #include <functional>
 #include <memory>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "orbis/features/frame_features.hpp"
 #include "orbis/geometry/se3.hpp"
@@ -33,7 +38,8 @@ struct FrameSnapshot {
   std::shared_ptr<const FrameFeatures> features;  // keypoints (shared with the map, immutable)
   std::vector<KeypointState> keypointStates;      // one per keypoint
   std::vector<MapPointId> localMapPoints;         // the tracker's local map after this frame
-  double imageWidth = 0, imageHeight = 0;
+  cv::Mat image;  // the input image (left of a stereo pair; grey or BGR), shared; may be empty
+  double imageWidth = 0, imageHeight = 0;         // the image's size (undistorted bounds without one)
   double extractionMs = 0, trackingMs = 0;        // tracking includes inline mapping (deterministic)
 };
 

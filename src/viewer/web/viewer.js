@@ -1,7 +1,8 @@
 // The orbis live viewer: draws the map and the current frame that LiveViewer streams as
 // server-sent events ("frame" and "map" messages, src/viewer/scene_json.hpp), with three.js.
 // Coordinates arrive as orbis keeps them (x right, y down, z forward); the world group turns
-// them to three.js's y-up. window.orbisScene holds the counts shown, for tests.
+// them to three.js's y-up. window.orbisScene holds the counts shown (images: camera images
+// drawn), for tests.
 'use strict';
 
 const STATE_COLOURS = ['#777777', '#4cd964', '#4aa3ff', '#ff4d4d'];  // unmatched, matched, new, outlier
@@ -10,10 +11,11 @@ const LAYERS = {
   loops: 'loop edges', trajectory: 'trajectory', camera: 'current camera',
 };
 
-window.orbisScene = { keyframes: 0, points: 0, frames: 0, loopClosures: 0, live: null, webgl: false };
+window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, live: null, webgl: false };
 const ui = (id) => document.getElementById(id);
 const view = { paused: false, latestFrame: null, latestMap: null, fitted: false, frustumSize: 0.05,
-               pointSize: 2, colouring: 'local', mode: 'follow', cameraCentre: null, loopsSeen: 0 };
+               pointSize: 2, colouring: 'local', mode: 'follow', cameraCentre: null, loopsSeen: 0,
+               userMoved: false };
 const timings = { extraction: [], tracking: [] };
 
 // ---- three.js scene ------------------------------------------------------------------------
@@ -33,7 +35,10 @@ scene.add(world);
 const camera = new THREE.PerspectiveCamera(55, 1, 0.005, 500);
 camera.position.set(0, 2, -3);
 const controls = renderer ? new THREE.OrbitControls(camera, renderer.domElement) : null;
-if (controls) controls.addEventListener('change', () => requestRender());
+if (controls) {
+  controls.addEventListener('change', () => requestRender());
+  controls.addEventListener('start', () => { view.userMoved = true; });  // the user's drag or wheel only
+}
 const layers = {};
 for (const name of Object.keys(LAYERS)) {
   layers[name] = new THREE.Group();
@@ -166,6 +171,8 @@ function followCamera() {
   controls.update();
 }
 
+function showSceneState() { ui('scene-state').textContent = JSON.stringify(window.orbisScene); }
+
 // ---- panel ---------------------------------------------------------------------------------------
 function median(values) {
   const s = [...values].sort((a, b) => a - b);
@@ -178,24 +185,52 @@ function showTiming(name, ms) {
   ui('t-' + name).textContent = ms.toFixed(1) + ' · ' + median(timings[name]).toFixed(1);
 }
 
+// The current image (a scaled-down JPEG; none from a run without images) under the keypoints,
+// drawn in the full image's pixels. Decoding is asynchronous: a frame whose image arrives after
+// a newer frame's is not drawn.
+const picture = { frame: null };
 function drawImage(frame) {
+  picture.frame = frame;
+  if (!frame.image) {
+    paintImage(frame, null);
+    return;
+  }
+  const img = new Image();
+  img.onload = () => { if (picture.frame === frame) paintImage(frame, img); };
+  img.src = 'data:image/jpeg;base64,' + frame.image;
+}
+
+function paintImage(frame, img) {  // the counts beside the picture are of the frame it shows
+  const counts = [0, 0, 0, 0];
+  for (let i = 2; i < frame.keypoints.length; i += 3) counts[frame.keypoints[i]]++;
+  ui('matches').textContent = `${counts[1]} / ${counts[2]} / ${counts[3]}`;
   const image = ui('image');
   if (frame.width > 0 && (image.width !== frame.width || image.height !== frame.height)) {
     image.width = frame.width;
     image.height = frame.height;
   }
   const g = image.getContext('2d');
-  g.fillStyle = '#05070a';
-  g.fillRect(0, 0, image.width, image.height);
-  const counts = [0, 0, 0, 0];
-  const k = frame.keypoints;
-  const r = Math.max(1.5, image.width / 320);
-  for (let i = 0; i < k.length; i += 3) {
-    counts[k[i + 2]]++;
-    g.fillStyle = STATE_COLOURS[k[i + 2]];
-    g.fillRect(k[i] - r, k[i + 1] - r, 2 * r, 2 * r);
+  if (img) {
+    g.imageSmoothingEnabled = true;
+    g.drawImage(img, 0, 0, image.width, image.height);
+    window.orbisScene.images++;
+    showSceneState();
+  } else {
+    g.fillStyle = '#05070a';
+    g.fillRect(0, 0, image.width, image.height);
   }
-  ui('matches').textContent = `${counts[1]} / ${counts[2]} / ${counts[3]}`;
+  // As ORB-SLAM2's frame drawer: a box and a centre dot per keypoint; unmatched ones only dimly.
+  const k = frame.keypoints;
+  const r = Math.max(2, image.width / 160);
+  g.lineWidth = Math.max(1, image.width / 400);
+  for (let i = 0; i < k.length; i += 3) {
+    const state = k[i + 2];
+    g.strokeStyle = g.fillStyle = STATE_COLOURS[state];
+    g.globalAlpha = state === 0 ? 0.45 : 1;
+    if (state !== 0) g.strokeRect(k[i] - r, k[i + 1] - r, 2 * r, 2 * r);
+    g.fillRect(k[i] - 1, k[i + 1] - 1, 2, 2);
+  }
+  g.globalAlpha = 1;
 }
 
 function applyFrame(frame) {
@@ -239,11 +274,12 @@ function applyMap(map) {
   announceLoops(map.loopClosures);
   ui('mode').textContent = map.live ? '— live' : '— finished run';
   ui('counts').textContent = `${map.keyFrames.length} / ${map.points.length / 5}`;
-  if (!view.fitted && controls && map.keyFrames.length) {
+  // The top view keeps the whole growing map in sight until the user moves the camera.
+  if (controls && map.keyFrames.length && (!view.fitted || (view.mode === 'top' && !view.userMoved))) {
     fitView(view.mode === 'top');
     view.fitted = true;
   }
-  ui('scene-state').textContent = JSON.stringify(window.orbisScene);
+  showSceneState();
   requestRender();
 }
 
@@ -260,6 +296,7 @@ function buildControls() {
   }
   ui('camera-mode').addEventListener('change', (e) => {
     view.mode = e.target.value;
+    view.userMoved = false;
     if (controls) fitView(view.mode === 'top');
   });
   ui('point-size').addEventListener('input', (e) => {
@@ -280,6 +317,15 @@ function buildControls() {
       if (view.latestFrame) applyFrame(view.latestFrame);
     }
   });
+}
+
+// ?view=follow|free|top in the address picks the camera mode at the start.
+function applyQuery() {
+  const mode = new URLSearchParams(location.search).get('view');
+  if (['follow', 'free', 'top'].includes(mode)) {
+    view.mode = mode;
+    ui('camera-mode').value = mode;
+  }
 }
 
 // The stream closes by itself once the run has finished (its map will not change), or, with
@@ -328,5 +374,6 @@ function animate() {
 }
 
 buildControls();
+applyQuery();
 connect();
 animate();

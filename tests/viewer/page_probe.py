@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""Loads a page in headless Chromium, waits until a JavaScript condition holds, then screenshots it.
+
+Drives Chromium over the DevTools protocol through --remote-debugging-pipe (JSON messages,
+NUL-terminated, on file descriptors 3 and 4): the standard library is enough, no WebSocket
+client or npm package. Prints the value of --report (JSON) when the condition held; logs every
+URL the page requested (Network.requestWillBeSent; data: URLs, decoded in place, left out) to
+--requests. Exits 1 when the condition
+did not hold within --timeout seconds (the screenshot is still taken, for a look at why).
+
+  page_probe.py URL --until 'window.orbisScene.loopClosures >= 1' --screenshot shot.png
+"""
+import argparse
+import base64
+import fcntl
+import json
+import os
+import select
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+
+class Chromium:
+    def __init__(self, binary, width, height, profile, extra_args=()):
+        to_browser_r, self._to_browser = os.pipe()
+        self._from_browser, from_browser_w = os.pipe()
+
+        def child_fds():  # the browser reads commands on fd 3 and writes answers on fd 4
+            r = fcntl.fcntl(to_browser_r, fcntl.F_DUPFD, 10)
+            w = fcntl.fcntl(from_browser_w, fcntl.F_DUPFD, 10)
+            os.dup2(r, 3)
+            os.dup2(w, 4)
+
+        self.process = subprocess.Popen(
+            [binary, "--headless", "--disable-gpu", "--no-sandbox", "--hide-scrollbars",
+             "--window-size=%d,%d" % (width, height), "--user-data-dir=" + profile,
+             "--remote-debugging-pipe", *extra_args, "about:blank"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            preexec_fn=child_fds, close_fds=False)
+        os.close(to_browser_r)
+        os.close(from_browser_w)
+        self._buffer = b""
+        self._next_id = 0
+        self.events = []
+
+    def _read_message(self, deadline):
+        while b"\0" not in self._buffer:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([self._from_browser], [], [], left)[0]:
+                raise TimeoutError("no answer from chromium")
+            chunk = os.read(self._from_browser, 1 << 20)
+            if not chunk:
+                raise EOFError("chromium closed the pipe")
+            self._buffer += chunk
+        message, self._buffer = self._buffer.split(b"\0", 1)
+        return json.loads(message)
+
+    def call(self, method, params=None, session=None, timeout=30):
+        self._next_id += 1
+        message = {"id": self._next_id, "method": method, "params": params or {}}
+        if session:
+            message["sessionId"] = session
+        os.write(self._to_browser, json.dumps(message).encode() + b"\0")
+        deadline = time.monotonic() + timeout
+        while True:
+            answer = self._read_message(deadline)
+            if answer.get("id") == self._next_id:
+                if "error" in answer:
+                    raise RuntimeError("%s: %s" % (method, answer["error"]))
+                return answer.get("result", {})
+            self.events.append(answer)
+
+    def close(self):
+        try:
+            self.call("Browser.close", timeout=5)
+        except Exception:
+            pass
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("url")
+    parser.add_argument("--until", default="true", help="JavaScript expression to wait for")
+    parser.add_argument("--report", default="JSON.stringify(window.orbisScene)", help="JavaScript expression to print")
+    parser.add_argument("--screenshot", help="PNG file")
+    parser.add_argument("--requests", help="file: every URL the page requested, one a line")
+    parser.add_argument("--timeout", type=float, default=120)
+    parser.add_argument("--settle", type=float, default=0.5, help="seconds between the condition and the shot")
+    parser.add_argument("--size", default="1400x800")
+    parser.add_argument("--chromium", default=shutil.which("chromium") or shutil.which("chromium-browser"))
+    parser.add_argument("--chromium-arg", action="append", default=[], help="one more Chromium flag (repeatable)")
+    args = parser.parse_args()
+    width, height = map(int, args.size.split("x"))
+    profile = tempfile.mkdtemp(prefix="page_probe_")
+    browser = Chromium(args.chromium, width, height, profile, args.chromium_arg)
+    held = False
+    try:
+        target = browser.call("Target.createTarget", {"url": "about:blank"})["targetId"]
+        session = browser.call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+        browser.call("Network.enable", session=session)
+        browser.call("Page.enable", session=session)
+        browser.call("Page.navigate", {"url": args.url}, session=session)
+        deadline = time.monotonic() + args.timeout
+        while time.monotonic() < deadline:
+            result = browser.call("Runtime.evaluate", {"expression": "Boolean(%s)" % args.until, "returnByValue": True},
+                                  session=session)
+            if result.get("result", {}).get("value") is True:
+                held = True
+                break
+            time.sleep(0.2)
+        time.sleep(args.settle)
+        report = browser.call("Runtime.evaluate", {"expression": args.report, "returnByValue": True}, session=session)
+        print(report.get("result", {}).get("value"))
+        if args.screenshot:
+            shot = browser.call("Page.captureScreenshot", {"format": "png"}, session=session)
+            with open(args.screenshot, "wb") as f:
+                f.write(base64.b64decode(shot["data"]))
+        if args.requests:
+            urls = [e["params"]["request"]["url"] for e in browser.events
+                    if e.get("method") == "Network.requestWillBeSent"]
+            urls = [u for u in urls if not u.startswith("data:")]  # decoded in place, not fetched
+            with open(args.requests, "w") as f:
+                f.write("".join(u + "\n" for u in urls))
+    finally:
+        browser.close()
+        shutil.rmtree(profile, ignore_errors=True)
+    if not held:
+        print("page_probe: %r did not hold within %g s" % (args.until, args.timeout), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
