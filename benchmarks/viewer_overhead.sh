@@ -11,7 +11,8 @@
 # tracking stages ("tracking: total") and of the observer's per-frame copy ("tracking: observer",
 # only with the viewer), their sum; and the CPU seconds of the whole orbis process. On a shared,
 # loaded machine single runs move by tens of percent: the summary compares the best run of each
-# kind (the least disturbed) and the median CPU seconds.
+# kind (the least disturbed), the medians of the runs, and the median CPU seconds; each run with
+# the viewer also prints what the viewer's publisher thread did.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 sequence=${1:-$root/../shared/datasets/tum_fr3_teddy_200}
@@ -36,7 +37,7 @@ run() {  # run NAME [orbis args...]: CPU seconds (user + system) into NAME.cpu
   local name=$1
   shift
   /usr/bin/time -f "%U %S" -o "$work/$name.time" "$orbis" run tum "$sequence" \
-    --settings "$root/examples/settings/TUM3.yaml" --out "$work/$name" "$@" >/dev/null 2>&1
+    --settings "$root/examples/settings/TUM3.yaml" --out "$work/$name" "$@" >"$work/$name.log" 2>&1
   awk '{print $1 + $2}' "$work/$name.time" >"$work/$name.cpu"
 }
 
@@ -45,8 +46,10 @@ with_viewer() {
   local pid=$! reader=""
   for _ in $(seq 50); do curl -s -m 1 -o /dev/null "http://127.0.0.1:$port/" && break; sleep 0.1; done
   if [[ $client == chromium ]]; then
-    timeout 300 chromium --headless --disable-gpu --no-sandbox --window-size=1400,800 \
-      --user-data-dir="$work/profile" --dump-dom "http://127.0.0.1:$port/?maps=100000" >/dev/null 2>&1 &
+    # Stays on the page, rendering, until it shows the finished run (--dump-dom would leave after
+    # the first messages).
+    python3 "$root/tests/viewer/page_probe.py" "http://127.0.0.1:$port/" --until "window.orbisScene.live === false" \
+      --timeout 300 >/dev/null 2>&1 &
   else
     curl -s -N -m 300 "http://127.0.0.1:$port/events" >"$work/events.txt" &
   fi
@@ -65,6 +68,8 @@ for pair in $(seq "$pairs"); do
     read -r e k o sum < <(per_frame_ms "$work/$kind/report.json")
     echo "$sum $(cat "$work/$kind.cpu")" >>"$work/$kind.sums"
     printf "%-6s %11s %9s %9s %9s %8s\n" "$kind $pair" "$e" "$k" "$o" "$sum" "$(cat "$work/$kind.cpu")"
+    # What the viewer's own thread did (messages, bytes, its CPU): the cost that is not on tracking's.
+    [[ $kind == off ]] || grep -h "^viewer: [0-9]" "$work/on.log" | sed 's/^/         /' || true
   done
 done
 python3 - "$work/off.sums" "$work/on.sums" <<'PY'
@@ -75,6 +80,9 @@ best_off, best_on = min(s for s, _ in off), min(s for s, _ in on)
 cpu_off, cpu_on = statistics.median(c for _, c in off), statistics.median(c for _, c in on)
 print("best tracking time per frame: %.2f ms without, %.2f ms with the viewer (%+.1f%%)"
       % (best_off, best_on, 100 * (best_on - best_off) / best_off))
+med_off, med_on = statistics.median(s for s, _ in off), statistics.median(s for s, _ in on)
+print("median tracking time per frame: %.2f ms without, %.2f ms with the viewer (%+.1f%%)"
+      % (med_off, med_on, 100 * (med_on - med_off) / med_off))
 print("median CPU of the run: %.2f s without, %.2f s with the viewer (%+.1f%%)"
       % (cpu_off, cpu_on, 100 * (cpu_on - cpu_off) / cpu_off))
 PY
