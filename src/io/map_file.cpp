@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "orbis/bow/vocabulary_file.hpp"
@@ -100,6 +102,8 @@ class Reader {
     for (double& v : t) v = get<double>(what);
     const Eigen::Quaterniond quaternion(q[3], q[0], q[1], q[2]);
     if (!(std::abs(quaternion.norm() - 1.0) < 1e-6)) fail(std::string("non-unit rotation in ") + what);
+    for (double v : t)
+      if (!std::isfinite(v)) fail(std::string("non-finite translation in ") + what);
     return SE3d(quaternion, Eigen::Vector3d(t[0], t[1], t[2]));
   }
   std::size_t position() const { return pos_; }
@@ -351,9 +355,15 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
       e.word = r.get<bow::WordId>("bag of words");
       e.weight = r.get<bow::WordValue>("bag of words");
     }
+    if (expected.vocabularyWords > 0)
+      for (const bow::WordEntry& e : kf.bow)
+        if (e.word >= expected.vocabularyWords) r.fail("word id beyond this system's vocabulary");
     kf.groups = r.getArray<NodeFeature>("feature vector");
-    for (const NodeFeature& g : kf.groups)
+    for (const NodeFeature& g : kf.groups) {
       if (g.feature >= kf.features->size()) r.fail("feature vector index out of range");
+      if (expected.vocabularyNodes > 0 && g.node >= expected.vocabularyNodes)
+        r.fail("feature vector node beyond this system's vocabulary");
+    }
     kf.parent = r.get<std::int64_t>("spanning-tree parent");
     kf.loops = r.getArray<std::uint64_t>("loop edges");
     kf.edges = r.getArray<Edge>("covisibility edges");
@@ -361,14 +371,30 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
     keyFrames.push_back(std::move(kf));
   }
   auto known = [&](std::uint64_t id) { return keyFrameIndex.count(id) != 0; };
+  // The graphs must be ones the running system could have built: an edge to itself, a negative
+  // weight or a cycle in the spanning tree would send later graph walks (essential graph, culling
+  // re-parenting) into loops the checks above cannot see.
   for (const KeyFrameRecord& kf : keyFrames) {
     if (kf.parent >= 0 && !known(static_cast<std::uint64_t>(kf.parent))) r.fail("parent is not a saved keyframe");
+    if (kf.parent >= 0 && static_cast<std::uint64_t>(kf.parent) == kf.id) r.fail("keyframe is its own parent");
     for (std::uint64_t l : kf.loops)
-      if (!known(l)) r.fail("loop edge to a keyframe not saved");
+      if (!known(l) || l == kf.id) r.fail("loop edge to a keyframe not saved, or to itself");
     for (const Edge& e : kf.edges)
-      if (!known(e.keyFrame)) r.fail("covisibility edge to a keyframe not saved");
+      if (!known(e.keyFrame) || e.keyFrame == kf.id || e.weight < 0 || e.weight > std::numeric_limits<int>::max())
+        r.fail("covisibility edge to a keyframe not saved, to itself, or with an impossible weight");
+  }
+  for (const KeyFrameRecord& kf : keyFrames) {
+    std::int64_t parent = kf.parent;
+    for (std::size_t steps = 0; parent >= 0; ++steps) {
+      if (steps > keyFrames.size()) r.fail("cycle in the spanning tree");
+      parent = keyFrames[keyFrameIndex.at(static_cast<std::uint64_t>(parent))].parent;
+    }
   }
   std::vector<PointRecord> points;
+  std::unordered_set<std::uint64_t> pointIds;
+  // Each keypoint of a keyframe holds at most one point, and a point observes a keyframe once.
+  std::vector<std::vector<bool>> slotTaken(keyFrames.size());
+  for (std::size_t k = 0; k < keyFrames.size(); ++k) slotTaken[k].assign(keyFrames[k].features->size(), false);
   for (std::uint64_t k = 0; k < info.mapPoints; ++k) {
     PointRecord p;
     p.id = r.get<std::uint64_t>("map point id");
@@ -379,10 +405,18 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
     p.visible = r.get<std::int32_t>("map point counters");
     p.found = r.get<std::int32_t>("map point counters");
     p.observations = r.getArray<Observation>("observations");
+    if (!pointIds.insert(p.id).second) r.fail("duplicate map point id");
+    if (!p.position.allFinite()) r.fail("non-finite map point position");
     if (p.reference < 0 || !known(static_cast<std::uint64_t>(p.reference))) r.fail("map point reference not saved");
-    for (const Observation& o : p.observations)
+    std::unordered_set<std::uint64_t> observers;
+    for (const Observation& o : p.observations) {
       if (!known(o.keyFrame) || o.index >= keyFrames[keyFrameIndex[o.keyFrame]].features->size())
         r.fail("observation of an unknown keyframe or keypoint");
+      if (!observers.insert(o.keyFrame).second) r.fail("map point observes a keyframe twice");
+      std::vector<bool>::reference taken = slotTaken[keyFrameIndex[o.keyFrame]][o.index];
+      if (taken) r.fail("keypoint observed by two map points");
+      taken = true;
+    }
     points.push_back(std::move(p));
   }
   if (r.position() != bytes.size() - kTrailerBytes) r.fail("unexpected bytes after the last map point");

@@ -173,7 +173,15 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   bar.finish();
   slam.shutdown();
   if (options.observer) options.observer->detach(slam.mapSnapshot());
-  if (options.saveMap && !failure) slam.core().saveMap(*options.saveMap);
+  // A map that cannot be saved (an unwritable folder) must not cost the run's other outputs:
+  // they are written below, then the error is reported.
+  if (options.saveMap && !failure) {
+    try {
+      slam.core().saveMap(*options.saveMap);
+    } catch (const Error&) {
+      failure = std::current_exception();
+    }
+  }
   const RelocalisationStats relocalisation = slam.core().relocalisationStats();
   report.relocalisationAttempts = relocalisation.attempts;
   report.relocalisations = relocalisation.successes;

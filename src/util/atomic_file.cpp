@@ -11,13 +11,16 @@ void writeFileAtomically(const std::filesystem::path& path, std::span<const char
   std::error_code ignored;
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw fileError(temporary.string(), "cannot open for writing");
+    // Named after the file the user asked for; the temporary beside it is ours.
+    if (!out)
+      throw fileError(path.string(), "cannot write (the temporary " + temporary.filename().string() +
+                                         " beside it cannot be created: missing folder or no permission)");
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.flush();
     if (!out) {
       out.close();
       std::filesystem::remove(temporary, ignored);
-      throw fileError(temporary.string(), "write failed (disk full?)");
+      throw fileError(path.string(), "write failed (disk full?); the file was left as it was");
     }
   }
   std::error_code ec;

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <string>
 
 #include <opencv2/imgcodecs.hpp>
@@ -16,6 +17,7 @@
 #include "orbis/bow/vocabulary_file.hpp"
 #include "orbis/camera/euroc_calibration.hpp"
 #include "orbis/io/bal.hpp"
+#include "orbis/io/map_file.hpp"
 #include "orbis/io/settings.hpp"
 #include "orbis/io/trajectory.hpp"
 #include "orbis/util/error.hpp"
@@ -157,6 +159,25 @@ void vocabularyBinaryResealed(const std::uint8_t* data, std::size_t size) {
   bow::OrbVocabulary::load(writeFile("vocabulary_resealed.bin", bytes.data(), bytes.size()));
 }
 
+// A map file with its declared size and checksum trailer recomputed (a map file's first 16 bytes are
+// magic, version and sensor; bytes 16..24 its size): without that, nearly every mutation stops at
+// the checksum and the structure checks behind it would never be fuzzed. The file is loaded
+// against its own header, as `orbis view` does, so every field is reached.
+void mapFile(const std::uint8_t* data, std::size_t size) {
+  std::vector<std::uint8_t> bytes(data, data + size);
+  if (bytes.size() >= 160) {
+    const std::uint64_t declared = bytes.size();
+    std::memcpy(bytes.data() + 16, &declared, sizeof declared);
+    const std::uint64_t sum = bow::checksum64(bytes.data(), bytes.size() - 8);
+    std::memcpy(bytes.data() + bytes.size() - 8, &sum, sizeof sum);
+  }
+  const fs::path file = writeFile("orbis.map", bytes.data(), bytes.size());
+  const MapFileInfo info = readMapFileInfo(file);
+  Map map;
+  std::lock_guard lock(map.mutex());
+  readMapFile(file, map, info);
+}
+
 void vocabularyText(const std::uint8_t* data, std::size_t size) {
   bow::readDbow2Text<bow::OrbVocabulary>(writeFile("vocabulary.txt", data, size));
 }
@@ -182,6 +203,7 @@ const std::vector<Harness>& harnesses() {
       {"vocabulary_binary", vocabularyBinary},
       {"vocabulary_binary_resealed", vocabularyBinaryResealed},
       {"vocabulary_text", vocabularyText},
+      {"map_file", mapFile},
   };
   return all;
 }

@@ -245,6 +245,14 @@ TEST(MapFile, OtherVocabularySensorOrCameraIsAnError) {
   MapFileInfo otherCamera = expectation();
   otherCamera.intrinsics.fx = 520;
   expectLoadError(file, otherCamera, "key fx");
+  // Word ids (below 1000 here) beyond a vocabulary of 10 words: a corrupt id must not reach the
+  // keyframe database, whose inverted index it would size.
+  MapFileInfo smallVocabulary = expectation();
+  smallVocabulary.vocabularyWords = 10;
+  expectLoadError(file, smallVocabulary, "word id beyond this system's vocabulary");
+  MapFileInfo fewNodes = expectation();
+  fewNodes.vocabularyNodes = 5;
+  expectLoadError(file, fewNodes, "feature vector node beyond this system's vocabulary");
   fs::remove(file);
 }
 

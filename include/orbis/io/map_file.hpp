@@ -14,8 +14,11 @@
 // the same order (ids are renumbered densely, order preserved). The mean viewing direction and
 // the scale-invariance distances are recomputed from the observations (the same computation on
 // the same data). readMapFile checks, in this order, size, magic, version, declared size,
-// checksum, then the caller's expectations (sensor, vocabulary, camera), and throws
-// orbis::Error naming the file and the defect — nothing is added to the map on failure.
+// checksum, then the caller's expectations (sensor, vocabulary, camera), then every record: counts
+// the remaining bytes cannot hold, indices out of range, non-finite poses and positions, graphs
+// the running system could not have built (self edges, a cycle in the spanning tree, a keypoint
+// held by two points, word or node ids beyond the caller's vocabulary). It throws orbis::Error
+// naming the file and the defect — nothing is added to the map on failure.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +37,10 @@ struct MapFileInfo {
   MapIntrinsics intrinsics;  // of the system that saved it (fx, fy, cx, cy, bf are checked)
   std::uint64_t vocabularyChecksum = 0;
   std::uint64_t keyFrames = 0, mapPoints = 0;
+  // Not in the file: when non-zero, what readMapFile's caller's vocabulary holds. Every word and
+  // node id of the keyframes' BoW and feature vectors must be below them (a corrupt id would
+  // size the keyframe database's inverted index, or index the vocabulary, far out of bounds).
+  std::uint64_t vocabularyWords = 0, vocabularyNodes = 0;
 };
 
 // Identifies the vocabulary a map's BoW vectors belong to (checksum of its whole file block).
