@@ -155,7 +155,7 @@ def table(rows, label, base=None, base_label=None):
              "ratio: threaded median / ORB-SLAM2's median (issue 18).", ""]
     head = "| sequence | det ATE | det runs | thr ATE median | thr runs | spread | det RPE | thr RPE | KF det/thr | points det/thr | tracked | ratio thr (det) |"
     if base:
-        head = head[:-1] + " before: det ATE | thr ATE | spread | ratio thr |"
+        head += " before: det ATE | before: thr ATE | before: spread | before: ratio thr |"
     lines += [head, "|" + "---|" * (head.count("|") - 1)]
     for name, r in rows.items():
         ratio = f"{r['ratio_thr']:.2f} ({r['ratio_det']:.2f})" if "ratio_thr" in r else "-"
