@@ -76,6 +76,7 @@ int runCommand(const std::vector<std::string>& rawArgs) {
       .option("--save-map", "FILE", "save the final map (keyframes, points, graphs) for a later --load-map")
       .flag("--no-loop", "disable loop closing")
       .flag("--json", "print the report as JSON on standard output")
+      .flag("--stats", "write DIR/stats.jsonl: per-frame tracking and per-keyframe mapping counters (diagnosis)")
       .option("--viewer", "[PORT]", "serve a live view of the run at http://127.0.0.1:PORT/ (default port 8080)")
       .flag("--viewer-wait", "with --viewer: keep serving the finished run until Ctrl-C");
   if (!p.parse(args)) return 0;
@@ -90,6 +91,7 @@ int runCommand(const std::vector<std::string>& rawArgs) {
   options.outDir = p.get("--out");
   createOutputFolder(options.outDir);
   options.deterministic = p.has("--deterministic");
+  options.stats = p.has("--stats");
   options.localisationOnly = p.has("--localize");
   options.loopClosing = !p.has("--no-loop");
   if (auto d = p.getOptional("--dense")) options.denseCloud = *d;

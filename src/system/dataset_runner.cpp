@@ -54,6 +54,16 @@ Defaults datasetDefaults(DatasetKind kind) {
   return {1000, 30};
 }
 
+// One JSON object per line: {"kind": ..., name: value, ...}.
+void writeEvents(const fs::path& file, const std::vector<StageEvent>& events) {
+  std::ofstream out(file);
+  for (const StageEvent& e : events) {
+    out << "{\"kind\":\"" << e.kind << '"';
+    for (const auto& [name, value] : e.values) out << ",\"" << name << "\":" << value;
+    out << "}\n";
+  }
+}
+
 void writeReport(const fs::path& file, const RunReport& r) {
   JsonWriter w;
   w.beginObject();
@@ -115,6 +125,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   slamOptions.loopClosing = options.loopClosing;
   slamOptions.fps = fps;
   Slam<Sensor> slam(camera, orb, vocabulary, slamOptions);
+  slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {
     slam.core().loadMap(*options.loadMap);
     report.keyFramesLoaded = slam.core().loadedKeyFrames();
@@ -239,6 +250,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
     }
   }
   writeReport(options.outDir / "report.json", report);
+  if (options.stats) writeEvents(options.outDir / "stats.jsonl", slam.timer().events());
   if (failure) std::rethrow_exception(failure);
 }
 

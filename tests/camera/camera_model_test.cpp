@@ -168,6 +168,16 @@ TEST(CameraTraits, CloseFarThreshold) {
   EXPECT_TRUE(std::isinf(makeCamera<PinholeCamera<double>>().closeDepthThreshold()));
 }
 
+// A rectified pair's far keypoints enter BA as monocular (their small disparity carries the
+// rectification's sub-pixel offset as a scale bias); a depth sensor keeps its depth everywhere.
+TEST(CameraTraits, BundleAdjustmentDepthLimit) {
+  const auto stereo = makeCamera<RectifiedStereoCamera<double>>();
+  EXPECT_DOUBLE_EQ(bundleAdjustmentDepthLimit(stereo), stereo.closeDepthThreshold());
+  EXPECT_DOUBLE_EQ(bundleAdjustmentDepthLimit(RectifiedStereoCamera<double>(stereo.pinhole, 0.11, 2.0)), 2.0);
+  EXPECT_TRUE(std::isinf(bundleAdjustmentDepthLimit(makeCamera<RgbdCamera<double>>())));
+  EXPECT_TRUE(std::isinf(bundleAdjustmentDepthLimit(makeCamera<PinholeCamera<double>>())));
+}
+
 TEST(CameraCast, KeepsEveryParameter) {
   const RgbdCamera<double> camera(testPinhole<double>(), 0.08, 1000.0, 3.0);
   const RgbdCamera<float> f = camera.cast<float>();

@@ -12,6 +12,8 @@
 // tests/camera/camera_model_test.cpp holds such negative checks.
 #pragma once
 
+#include <limits>
+
 #include <concepts>
 
 #include <Eigen/Core>
@@ -66,6 +68,18 @@ struct CameraTraits {
   static constexpr bool kMetricDepth = C::kMetricDepth;
   static Scalar closeDepthThreshold(const C& camera) { return camera.closeDepthThreshold(); }
 };
+
+// Keypoints measured deeper than this enter bundle adjustment (motion-only, local and full) as
+// monocular observations, their depth left to the views' parallax: the close-depth threshold of a
+// camera model that declares kFarDepthMonocular (RectifiedStereoCamera), else infinity (ORB-SLAM2:
+// every stereo reading is a stereo residual).
+template <CameraModel C>
+double bundleAdjustmentDepthLimit(const C& camera) {
+  if constexpr (requires { C::kFarDepthMonocular; }) {
+    if constexpr (C::kFarDepthMonocular) return static_cast<double>(camera.closeDepthThreshold());
+  }
+  return std::numeric_limits<double>::infinity();
+}
 
 static_assert(CameraModel<PinholeCamera<double>> && CameraModel<PinholeCamera<float>>);
 static_assert(CameraModel<RectifiedStereoCamera<double>> && CameraModel<RectifiedStereoCamera<float>>);

@@ -77,6 +77,13 @@ template <class S = double>
 struct RectifiedStereoCamera : detail::StereoGeometry<S> {
   using Base = detail::StereoGeometry<S>;
 
+  // A rectified pair measures depth through a disparity of a few pixels for far points (beyond
+  // closeDepthThreshold()), where a sub-pixel offset of the rectification or of the disparity
+  // interpolation becomes a depth (scale) bias the same in every frame, which BA cannot average
+  // away: far keypoints enter BA as monocular observations (bundleAdjustmentDepthLimit). A depth
+  // sensor has no such offset and keeps its readings at every depth.
+  static constexpr bool kFarDepthMonocular = true;
+
   RectifiedStereoCamera() = default;
   RectifiedStereoCamera(const PinholeCamera<S>& pinhole, S baseline)
       : Base(pinhole, baseline, Base::kDefaultCloseDepthInBaselines * baseline) {}

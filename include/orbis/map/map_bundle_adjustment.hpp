@@ -23,7 +23,12 @@ namespace orbis {
 
 struct LocalBundleAdjustmentStats {
   int keyFrames = 0, fixedKeyFrames = 0, points = 0, observations = 0, outliersRemoved = 0;
+  int iterations = 0;  // of both passes
   bool aborted = false;
+  // Stereo cameras: mean measured minus BA-predicted disparity (px) of the inlier stereo matches,
+  // near and far (diagnosis of a disparity bias; far ones are monocular in BA, so unpulled).
+  double closeDisparityBias = 0, farDisparityBias = 0;
+  int closeStereo = 0, farStereo = 0;
 };
 
 template <optim::RobustKernel Kernel, CameraModel Camera>

@@ -27,8 +27,10 @@ struct BaSnapshot {
 };
 
 // Builds the problem for `free` keyframes and `points`; keyframes outside `free` that observe the
-// points enter fixed. The origin keyframe is always fixed (gauge). Caller holds the map mutex.
-inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points) {
+// points enter fixed. The origin keyframe is always fixed (gauge). Keypoints deeper than
+// depthLimit are monocular observations (bundleAdjustmentDepthLimit). Caller holds the map mutex.
+inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points,
+                          double depthLimit) {
   std::map<KeyFrame*, int, ById> poseOf;
   auto addPose = [&](KeyFrame* kf, bool fixed) {
     const int index = static_cast<int>(s.poses.size());
@@ -48,11 +50,34 @@ inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, con
       if (it == poseOf.end()) it = addPose(kf, true);
       const FrameFeatures& f = kf->features();
       const Keypoint& k = f.keypointsUn[index];
-      s.observations.push_back({it->second, pointIndex, Eigen::Vector3d(k.u, k.v, f.uRight[index]),
+      const double uRight = f.depth[index] > depthLimit ? -1.0 : f.uRight[index];  // far: monocular
+      s.observations.push_back({it->second, pointIndex, Eigen::Vector3d(k.u, k.v, uRight),
                                 f.scales.invSigma2[static_cast<std::size_t>(k.octave)]});
       s.keypointOf.push_back(index);
     }
   }
+}
+
+// LocalBundleAdjustmentStats' disparity bias over the solved snapshot (features are immutable:
+// no lock needed).
+template <CameraModel Camera>
+void disparityBias(const Camera& camera, const BaSnapshot& s, const std::vector<char>& outlier,
+                   LocalBundleAdjustmentStats& stats) {
+  double close = 0, far = 0;
+  for (std::size_t k = 0; k < s.observations.size(); ++k) {
+    if (outlier[k]) continue;
+    const auto pose = static_cast<std::size_t>(s.observations[k].pose);
+    const FrameFeatures& f = s.keyFrames[pose]->features();
+    const std::size_t i = s.keypointOf[k];
+    if (f.uRight[i] < 0) continue;
+    const double z = (s.poses[pose] * s.positions[static_cast<std::size_t>(s.observations[k].point)]).z();
+    if (z <= 0) continue;
+    const double d = (f.keypointsUn[i].u - f.uRight[i]) - camera.bf() / z;
+    if (f.depth[i] > camera.closeDepthThreshold()) { far += d; ++stats.farStereo; }
+    else { close += d; ++stats.closeStereo; }
+  }
+  if (stats.closeStereo) stats.closeDisparityBias = close / stats.closeStereo;
+  if (stats.farStereo) stats.farDisparityBias = far / stats.farStereo;
 }
 
 template <optim::RobustKernel Kernel, CameraModel Camera>
@@ -79,7 +104,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map,
     for (KeyFrame* k : local)
       for (MapPoint* p : k->points())
         if (p && !p->isBad() && seen.insert(p).second) points.push_back(p);
-    buildSnapshot(s, local, points);
+    buildSnapshot(s, local, points, bundleAdjustmentDepthLimit(camera));
     stats.keyFrames = static_cast<int>(local.size());
     stats.fixedKeyFrames = static_cast<int>(s.keyFrames.size() - local.size());
     stats.points = static_cast<int>(points.size());
@@ -93,7 +118,10 @@ LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map,
   options.refineIterations = 10;
   options.abortFlag = abort;
   const optim::BundleAdjustmentResult result = solve<Kernel>(camera, s, options);
-  stats.aborted = result.robustPass.termination == optim::Termination::Aborted;
+  stats.aborted = result.robustPass.termination == optim::Termination::Aborted ||
+                  result.refinePass.termination == optim::Termination::Aborted;
+  if constexpr (StereoCameraModel<Camera>) disparityBias(camera, s, result.outlier, stats);
+  stats.iterations = result.robustPass.iterations + result.refinePass.iterations;
 
   std::lock_guard lock(map.mutex());
   for (std::size_t k = 0; k < s.observations.size(); ++k) {
@@ -129,7 +157,7 @@ FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, 
     std::lock_guard lock(map.mutex());
     const auto keyFrames = map.keyFrames();
     if (keyFrames.empty()) return result;
-    buildSnapshot(s, keyFrames, map.mapPoints());
+    buildSnapshot(s, keyFrames, map.mapPoints(), bundleAdjustmentDepthLimit(camera));
   }
   // Huber throughout, no outlier pass: the loop closer merges the result through the spanning tree.
   optim::BundleAdjustmentOptions options;

@@ -84,6 +84,11 @@ class LocalMapper final : public LocalMappingControl {
   Map& map_;
   LocalMapperOptions options_;
   StageTimer* timer_;
+  // Diagnosis (`orbis run --stats`): counters of the keyframe being processed, logged with it.
+  std::vector<std::pair<std::string, double>> diagnostics_;
+  void note(const char* name, double value) {
+    if (timer_ && timer_->eventsEnabled()) diagnostics_.emplace_back(name, value);
+  }
   std::function<void(KeyFrame*)> sink_, culledSink_;
 
   std::list<MapPoint*> recentPoints_;

@@ -119,6 +119,10 @@ bool LocalMapper<Sensor>::processOne() {
   if (!next) return false;
   KeyFrame* kf = *next;
   ScopedStage total(timer_, "mapping: total");
+  diagnostics_.clear();
+  note("keyframe", static_cast<double>(kf->id));
+  note("frame", static_cast<double>(kf->frameIndex));
+  note("queued", static_cast<double>(queuedKeyFrames()));
   {
     ScopedStage stage(timer_, "mapping: keyframe insertion");
     std::lock_guard lock(map_.mutex());
@@ -146,7 +150,17 @@ bool LocalMapper<Sensor>::processOne() {
       {
         ScopedStage stage(timer_, "mapping: local BA");
         std::atomic<bool>* abort = options_.threaded ? &abortBA_ : nullptr;
-        localBundleAdjustment<typename Sensor::RobustKernel>(camera_, map_, kf, abort);
+        const LocalBundleAdjustmentStats ba = localBundleAdjustment<typename Sensor::RobustKernel>(camera_, map_, kf, abort);
+        note("ba_keyframes", ba.keyFrames);
+        note("ba_fixed", ba.fixedKeyFrames);
+        note("ba_points", ba.points);
+        note("ba_observations", ba.observations);
+        note("ba_outliers_removed", ba.outliersRemoved);
+        note("ba_aborted", ba.aborted);
+        note("ba_iterations", ba.iterations);
+        note("close_disparity_bias", ba.closeDisparityBias);
+        note("far_disparity_bias", ba.farDisparityBias);
+        note("far_stereo", ba.farStereo);
       }
       if (options_.cullKeyFrames) {
         ScopedStage stage(timer_, "mapping: keyframe culling");
@@ -156,11 +170,20 @@ bool LocalMapper<Sensor>::processOne() {
     }
   }
   if (sink_) sink_(kf);
+  if (timer_ && timer_->eventsEnabled()) {
+    std::lock_guard lock(map_.mutex());
+    note("skipped_ba", moreQueued);
+    note("keyframe_points", kf->trackedPoints(0));
+    note("map_points", static_cast<double>(map_.mapPointCount()));
+    timer_->event("keyframe", std::move(diagnostics_));
+    diagnostics_.clear();
+  }
   return true;
 }
 
 template <SensorConfiguration Sensor>
 void LocalMapper<Sensor>::processNewKeyFrame(KeyFrame* kf) {
+  int fromTracking = 0;
   for (std::size_t i = 0; i < kf->size(); ++i) {
     MapPoint* p = kf->point(i);
     if (!p) continue;
@@ -174,13 +197,16 @@ void LocalMapper<Sensor>::processNewKeyFrame(KeyFrame* kf) {
       p->computeDistinctiveDescriptor();
     } else if (p->reference() == kf) {
       recentPoints_.push_back(p);  // created by tracking from this keyframe's depth
+      ++fromTracking;
     }
   }
   kf->updateConnections();
+  note("points_from_tracking", fromTracking);
 }
 
 template <SensorConfiguration Sensor>
 void LocalMapper<Sensor>::cullRecentPoints(KeyFrame* kf) {
+  int culledRatio = 0, culledObservations = 0;
   const int minObservations = Sensor::kMetricScale ? 3 : 2;  // ORB-SLAM2: 2 for monocular
   for (auto it = recentPoints_.begin(); it != recentPoints_.end();) {
     MapPoint* p = *it;
@@ -188,9 +214,11 @@ void LocalMapper<Sensor>::cullRecentPoints(KeyFrame* kf) {
     if (p->isBad()) {
       it = recentPoints_.erase(it);
     } else if (p->foundRatio() < 0.25f) {
+      ++culledRatio;
       p->setBad();
       it = recentPoints_.erase(it);
     } else if (age >= 2 && p->observationCount() <= minObservations) {
+      ++culledObservations;
       p->setBad();
       it = recentPoints_.erase(it);
     } else if (age >= 3) {
@@ -199,6 +227,8 @@ void LocalMapper<Sensor>::cullRecentPoints(KeyFrame* kf) {
       ++it;
     }
   }
+  note("culled_found_ratio", culledRatio);
+  note("culled_observations", culledObservations);
 }
 
 namespace mapping_detail {
@@ -234,6 +264,7 @@ void LocalMapper<Sensor>::createNewMapPoints(KeyFrame* kf) {
   const SE3d Tcw1 = kf->Tcw();
   const double ratioFactor = 1.5 * f1.scales.factor();
   const PinholeCamera<double>& pinhole = pinholeOf(camera_);
+  int created = 0;
   double baseline = 0;  // a pair needs a wider base than the stereo one to beat its depth
   if constexpr (StereoCameraModel<Camera>) baseline = camera_.bf() / pinhole.fx;
   for (KeyFrame* kf2 : neighbours) {
@@ -295,8 +326,10 @@ void LocalMapper<Sensor>::createNewMapPoints(KeyFrame* kf) {
       p->computeDistinctiveDescriptor();
       p->updateNormalAndDepth();
       recentPoints_.push_back(p);
+      ++created;
     }
   }
+  note("triangulated", created);
 }
 
 template <SensorConfiguration Sensor>
@@ -310,13 +343,15 @@ void LocalMapper<Sensor>::fuseWithNeighbours(KeyFrame* kf) {
       if (!n2->isBad() && seen.insert(n2).second) targets.push_back(n2);
   }
   const std::vector<MapPoint*> own = kf->goodPoints();
-  for (KeyFrame* t : targets) matching::fuse(camera_, *t, own);
+  int fused = 0;
+  for (KeyFrame* t : targets) fused += matching::fuse(camera_, *t, own);
   std::vector<MapPoint*> candidates;
   std::set<MapPoint*, ById> candidateSet;
   for (KeyFrame* t : targets)
     for (MapPoint* p : t->points())
       if (p && !p->isBad() && candidateSet.insert(p).second) candidates.push_back(p);
-  matching::fuse(camera_, *kf, candidates);
+  fused += matching::fuse(camera_, *kf, candidates);
+  note("fused", fused);
   for (MapPoint* p : kf->goodPoints()) {
     p->computeDistinctiveDescriptor();
     p->updateNormalAndDepth();
@@ -349,6 +384,7 @@ void LocalMapper<Sensor>::cullKeyFrames(KeyFrame* kf) {
       if (seenElsewhere >= 3) ++redundant;
     }
     if (points > 0 && redundant > options_.redundancyRatio * points) {
+      note("culled_keyframe", static_cast<double>(k->id));
       k->setBad();
       if (culledSink_) culledSink_(k);
     }

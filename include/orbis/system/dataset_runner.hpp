@@ -37,6 +37,7 @@ struct RunOptions {
   std::optional<std::filesystem::path> loadMap;  // map file to localise in (io/map_file.hpp)
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
   SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned
+  bool stats = false;  // diagnosis: outDir/stats.jsonl, one line per frame and per keyframe (StageTimer events)
 };
 
 struct RunReport {

@@ -2,7 +2,8 @@
 //
 // Contract: optimizePose<Kernel> refines frame.Tcw from its matches (optim::motionOnlyBundleAdjustment
 // on the frame's camera model: mono, stereo or depth residuals as it calls for, the robust kernel
-// Kernel — the sensor's — information 1/σ² of the keypoint's level) in ORB-SLAM's four rounds
+// Kernel — the sensor's — information 1/σ² of the keypoint's level; keypoints beyond the camera's
+// bundleAdjustmentDepthLimit as monocular) in ORB-SLAM's four rounds
 // with χ² outlier classification (5.991 mono, 7.815 stereo and depth), writes frame.outlier for
 // every matched keypoint and returns the number of inliers. Frames with fewer than 3 matches are
 // left untouched (returns 0). Caller holds Map::mutex() (point positions are read).
@@ -24,12 +25,14 @@ int optimizePose(Frame<Camera>& frame) {
   points.reserve(frame.size());
   observations.reserve(frame.size());
   keypointOf.reserve(frame.size());
+  const double depthLimit = bundleAdjustmentDepthLimit(*frame.camera);
   for (std::size_t i = 0; i < frame.size(); ++i) {
     MapPoint* p = frame.points[i];
     if (!p) continue;
     frame.outlier[i] = 0;
     const Keypoint& k = f.keypointsUn[i];
-    observations.push_back({0, static_cast<int>(points.size()), Eigen::Vector3d(k.u, k.v, f.uRight[i]),
+    const double uRight = f.depth[i] > depthLimit ? -1.0 : f.uRight[i];  // far: monocular
+    observations.push_back({0, static_cast<int>(points.size()), Eigen::Vector3d(k.u, k.v, uRight),
                             f.scales.invSigma2[static_cast<std::size_t>(k.octave)]});
     points.push_back(p->position());
     keypointOf.push_back(i);

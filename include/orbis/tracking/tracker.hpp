@@ -136,6 +136,10 @@ class Tracker {
   // Runs motion-only BA on current_, then drops outliers; returns matches to map points kept.
   int optimiseAndDropOutliers();
   void recordKeypointStates();
+  // Diagnosis (`orbis run --stats`): a named counter of the current frame, logged with the frame.
+  void note(const char* name, double value) const {
+    if (timer_ && timer_->eventsEnabled()) diagnostics_.emplace_back(name, value);
+  }
 
   Map& map_;
   const OrbVocabulary& vocabulary_;
@@ -157,6 +161,7 @@ class Tracker {
   std::vector<KeypointState> keypointStates_;
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
   std::vector<TrackedFrame> tracked_;
+  mutable std::vector<std::pair<std::string, double>> diagnostics_;
 
   // Monocular initialisation: the reference frame, where its keypoints were last matched.
   std::optional<FrameT> initialReference_;

@@ -71,6 +71,8 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
   current_.resetMatches();
   if (recordKeypointStates_) keypointStates_.clear();
   TrackResult result;
+  diagnostics_.clear();
+  note("frame", static_cast<double>(current_.index));
 
   if (state_ == TrackingState::NotInitialised) {
     ScopedStage stage(timer_, "tracking: bootstrap");
@@ -155,6 +157,21 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
     result.inliers = matchesInliers_;
     tracked_.push_back({current_.index, current_.timestamp, reference_, current_.Tcw * reference_->Tcw().inverse()});
   }
+  if (timer_ && timer_->eventsEnabled()) {
+    int stereo = 0, close = 0;
+    for (std::size_t i = 0; i < current_.size(); ++i) {
+      stereo += current_.features->depth[i] > 0;
+      close += current_.isClose(i);
+    }
+    note("keypoints", static_cast<double>(current_.size()));
+    note("stereo", stereo);
+    note("close", close);
+    note("ok", state_ == TrackingState::Ok);
+    note("new_keyframe", result.newKeyFrame);
+    note("map_keyframes", static_cast<double>(map_.keyFrameCount()));
+    timer_->event("frame", std::move(diagnostics_));
+    diagnostics_.clear();
+  }
   if (state_ != TrackingState::NotInitialised) last_ = std::move(current_);  // current_ is refilled next frame
   return result;
 }
@@ -222,6 +239,7 @@ bool Tracker<Sensor>::trackReferenceKeyFrame() {
   computeBow(current_);
   std::vector<MapPoint*> matches;
   const int n = matching::matchByBow(*reference_, current_, matches, 0.7f, true);
+  note("reference_matches", n);
   if (n < 15) return false;
   current_.points = std::move(matches);
   current_.outlier.assign(current_.size(), 0);
@@ -266,8 +284,10 @@ bool Tracker<Sensor>::trackWithMotionModel(const SE3d& motion) {
     current_.resetMatches();
     n = matching::matchFromLastFrame(current_, last_, 2 * radius, !kStereo);
   }
+  note("motion_matches", n);
   if (n < 20) return false;
   const int matchesMap = optimiseAndDropOutliers();
+  note("motion_inliers", matchesMap);
   if (options_.localisationOnly) return current_.inliers() >= 10 || matchesMap >= 10;
   return matchesMap >= 10;
 }
@@ -367,7 +387,10 @@ int Tracker<Sensor>::searchLocalPoints() {
 template <SensorConfiguration Sensor>
 bool Tracker<Sensor>::trackLocalMap() {
   updateLocalMap();
-  searchLocalPoints();
+  const int found = searchLocalPoints();
+  note("local_keyframes", static_cast<double>(localKeyFrames_.size()));
+  note("local_points", static_cast<double>(localPoints_.size()));
+  note("local_matches", found);
   optimizePose<typename Sensor::RobustKernel>(current_);
   matchesInliers_ = 0;
   for (std::size_t i = 0; i < current_.size(); ++i) {
@@ -382,6 +405,7 @@ bool Tracker<Sensor>::trackLocalMap() {
     }
   }
   const auto maxFrames = static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
+  note("inliers", matchesInliers_);
   if (withinFramesOfRelocalisation(maxFrames) && matchesInliers_ < 50) return false;
   return matchesInliers_ >= 30;
 }
@@ -405,12 +429,18 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
     else ++untrackedClose;
   }
   const bool needClose = trackedClose < options_.closeTrackedThreshold && untrackedClose > options_.closeCreatableThreshold;
+  note("tracked_close", trackedClose);
+  note("untracked_close", untrackedClose);
+  note("reference_tracked", referenceMatches);
+  note("mapper_idle", mapperIdle);
+  note("mapper_queue", mapper_ ? static_cast<double>(mapper_->queuedKeyFrames()) : 0.0);
   const float refRatio = keyFrames < 2 ? 0.4f : 0.75f;
   const bool c1a = current_.index >= lastKeyFrameFrame_ + maxFrames;
   const bool c1b = current_.index >= lastKeyFrameFrame_ + static_cast<std::uint64_t>(options_.minFramesBetweenKeyFrames) && mapperIdle;
   const bool c1c = matchesInliers_ < referenceMatches * 0.25f || needClose;
   const bool c2 = (matchesInliers_ < referenceMatches * refRatio || needClose) && matchesInliers_ > 15;
   if (!((c1a || c1b || c1c) && c2)) return false;
+  note("keyframe_wanted", 1);
   if (mapperIdle) return true;
   if (mapper_) mapper_->interruptBundleAdjustment();
   return mapper_ && mapper_->queuedKeyFrames() < 3;
@@ -428,7 +458,10 @@ void Tracker<Sensor>::createNewKeyFrame() {
     if (current_.points[i]) kf->setPoint(i, current_.points[i]);
   // Close stereo points become map points at once (paper §III-A); far ones only while fewer than
   // 100 points were added, nearest first.
-  for (const std::size_t i : tracking_detail::keypointsToLift(current_)) tracking_detail::createPointFromDepth(map_, current_, kf, i);
+  int created = 0;
+  for (const std::size_t i : tracking_detail::keypointsToLift(current_))
+    created += tracking_detail::createPointFromDepth(map_, current_, kf, i) != nullptr;
+  note("points_from_depth", created);
   lastKeyFrameFrame_ = current_.index;
   if (mapper_) {
     mapper_->insertKeyFrame(kf);

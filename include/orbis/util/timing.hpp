@@ -2,10 +2,13 @@
 //
 // Contract: StageTimer records durations (ms) under stage names; summary() gives count, mean,
 // median, p95 and max per stage, in the order stages were first recorded. Thread-safe: the
-// tracking, local-mapping and loop-closing threads record into one instance.
+// tracking, local-mapping and loop-closing threads record into one instance. With events enabled
+// (diagnosis: `orbis run --stats`), stages also log per-frame and per-keyframe counters as named
+// values; disabled, event() is a no-op and callers skip building them (eventsEnabled()).
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -21,8 +24,26 @@ struct StageStats {
   double meanMs = 0, medianMs = 0, p95Ms = 0, maxMs = 0;
 };
 
+// One logged event: what it is about ("frame", "keyframe") and its named values.
+struct StageEvent {
+  std::string kind;
+  std::vector<std::pair<std::string, double>> values;
+};
+
 class StageTimer {
  public:
+  void enableEvents(bool on) { eventsOn_ = on; }
+  bool eventsEnabled() const { return eventsOn_; }
+  void event(std::string kind, std::vector<std::pair<std::string, double>> values) {
+    if (!eventsOn_) return;
+    std::lock_guard lock(mutex_);
+    events_.push_back({std::move(kind), std::move(values)});
+  }
+  std::vector<StageEvent> events() const {
+    std::lock_guard lock(mutex_);
+    return events_;
+  }
+
   void record(const std::string& stage, double ms) {
     std::lock_guard lock(mutex_);
     for (auto& [name, samples] : stages_)
@@ -53,6 +74,8 @@ class StageTimer {
  private:
   mutable std::mutex mutex_;
   std::vector<std::pair<std::string, std::vector<double>>> stages_;
+  std::atomic<bool> eventsOn_{false};
+  std::vector<StageEvent> events_;
 };
 
 // Measures the scope it lives in and records it into a StageTimer (or nowhere, if null).
