@@ -119,10 +119,10 @@ class LoopCloser {
   void dropBadKeyFrames();
   std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf);
   bool computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out);
-  // One candidate's transform from its bag-of-words matches: SE(3) or Sim(3) by the sensor.
-  bool rigidTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches, LoopCandidate& out);
-  bool similarityTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches,
-                           LoopCandidate& out);
+  // One candidate's transform from its bag-of-words matches (ORB-SLAM's ComputeSim3): RANSAC,
+  // guided matching both ways through its result, two-way refinement; SE(3) or Sim(3) by the
+  // sensor. Fills out.loopKeyFrame, the corrected pose and the inlier matches.
+  bool loopTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches, LoopCandidate& out);
   // Takes the map mutex itself (pauses local mapping first):
   void correctLoop(KeyFrame* kf, LoopCandidate& loop);
   using PoseMap = std::map<KeyFrame*, SE3d, ById>;
