@@ -77,6 +77,13 @@ void writeReport(const fs::path& file, const RunReport& r) {
     w.field("p95", s.p95Ms).field("max", s.maxMs).endObject();
   }
   w.endObject();
+  // "scale": the current keyframe's map scale over the loop keyframe's (1 for metric sensors).
+  w.key("loops").beginArray();
+  for (const LoopClosureEvent& e : r.loopClosures) {
+    w.beginObject().field("current_keyframe", e.current).field("loop_keyframe", e.loop).field("frame", e.frameIndex);
+    w.field("inliers", e.inliers).field("scale", e.scale).endObject();
+  }
+  w.endArray();
   // Repeated warnings folded (a few of each kind, then a count), as the program prints them.
   const std::vector<WarningKind> kinds = foldWarnings(r.warnings);
   w.key("warnings").beginArray();
@@ -180,6 +187,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.stats = slam.stats();
   report.timing = slam.timer().summary();
+  if (const auto* closer = slam.core().loopCloser()) report.loopClosures = closer->closures();
 
   fs::create_directories(options.outDir);
   const Trajectory trajectory = slam.trajectory();

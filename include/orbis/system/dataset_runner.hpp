@@ -51,6 +51,8 @@ struct RunReport {
   std::size_t keyFramesLoaded = 0;  // from RunOptions::loadMap
   std::size_t densePoints = 0;      // voxels in RunOptions::denseCloud
   std::size_t relocalisationAttempts = 0, relocalisations = 0;
+  // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.
+  std::vector<LoopClosureEvent> loopClosures;
 };
 
 RunReport runDataset(DatasetReader& dataset, const RunOptions& options);
