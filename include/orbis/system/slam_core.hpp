@@ -10,7 +10,11 @@
 
 #include <atomic>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
 #include <vector>
 
 #include "orbis/bow/keyframe_database.hpp"
@@ -34,9 +38,28 @@ struct SlamOptions {
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
 };
 
+// GATE (remove when Sim(3) loop closing merges, branch sim3): LoopCloser<Sensor> is SE(3) only
+// and static_asserts a metric sensor, so a sensor without metric scale gets this stand-in type,
+// which is never created (SlamCore's constructor leaves the pointer null); it only lets the
+// calls below compile. Merging: make LoopCloserOf<Sensor> LoopCloser<Sensor> and drop the
+// `if constexpr` in SlamCore's constructor.
+struct NoLoopCloser {
+  void insertKeyFrame(KeyFrame*) {}
+  void runUntilIdle() {}
+  void waitUntilIdle() {}
+  void shutdown() {}
+  std::vector<LoopClosureEvent> closures() const { return {}; }
+};
+template <class Sensor>
+using LoopCloserOf = std::conditional_t<Sensor::kMetricScale, LoopCloser<Sensor>, NoLoopCloser>;
+
 struct SlamStats {
   std::size_t frames = 0, tracked = 0, lost = 0, keyFrames = 0, mapPoints = 0;
   std::size_t loopClosures = 0;
+  // The frame the map started on (monocular: the second view of the accepted pair), and why the
+  // frames before it did not start it (Tracker::initialisationWaits: reason -> frames).
+  std::optional<std::uint64_t> initialisedAtFrame;
+  std::map<std::string, std::size_t> initialisationWaits;
 };
 
 // Everything after feature extraction: tracking, local mapping, loop closing and relocalisation
@@ -84,8 +107,9 @@ class SlamCore {
   const Camera& camera() const { return camera_; }
   // What the map file records of the camera.
   const MapIntrinsics& intrinsics() const { return intrinsics_; }
-  // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode).
-  const LoopCloser<Sensor>* loopCloser() const { return loopCloser_.get(); }
+  // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode) and, until
+  // Sim(3) loops merge, for sensors without metric scale.
+  const LoopCloserOf<Sensor>* loopCloser() const { return loopCloser_.get(); }
 
  private:
   const Camera camera_;  // every stage below holds a reference to it
@@ -98,10 +122,11 @@ class SlamCore {
   std::unique_ptr<Relocaliser<Sensor>> relocaliser_;
   std::size_t loadedKeyFrames_ = 0;
   std::unique_ptr<LocalMapper<Sensor>> mapper_;
-  std::unique_ptr<LoopCloser<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
+  std::unique_ptr<LoopCloserOf<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
   std::unique_ptr<Tracker<Sensor>> tracker_;
   std::atomic<std::uint64_t> frames_{0};  // atomic: mapSnapshot() reads it from an observer's thread
   std::uint64_t lost_ = 0;
+  std::optional<std::uint64_t> initialisedAtFrame_;
   FrameObserver frameObserver_;
   bool shutDown_ = false;
 };
@@ -131,5 +156,6 @@ MapIntrinsics mapIntrinsicsOf(const Camera& camera) {
 namespace orbis {
 extern template class SlamCore<Stereo>;
 extern template class SlamCore<Rgbd>;
+extern template class SlamCore<Monocular>;
 
 }  // namespace orbis

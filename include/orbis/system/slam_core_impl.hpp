@@ -18,11 +18,13 @@ SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabu
   LocalMapperOptions mapperOptions;
   mapperOptions.threaded = !options_.deterministic;
   mapper_ = std::make_unique<LocalMapper<Sensor>>(camera_, map_, mapperOptions, &timer_);
-  if (options_.loopClosing && !options_.localisationOnly) {
-    LoopCloserOptions loopOptions;
-    loopOptions.threaded = !options_.deterministic;
-    loopOptions.seed = options_.seed;
-    loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);
+  if constexpr (Sensor::kMetricScale) {  // GATE: Sim(3) loop closing not merged yet (slam_core.hpp)
+    if (options_.loopClosing && !options_.localisationOnly) {
+      LoopCloserOptions loopOptions;
+      loopOptions.threaded = !options_.deterministic;
+      loopOptions.seed = options_.seed;
+      loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);
+    }
   }
   // Processed keyframes feed the keyframe database: through the loop closer (which queries it
   // before adding each one) or directly.
@@ -84,6 +86,7 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     result = tracker_->track(std::move(frame));
   }
   if (result.state == TrackingState::Lost) ++lost_;
+  if (result.state != TrackingState::NotInitialised && !initialisedAtFrame_) initialisedAtFrame_ = frames_ - 1;
   // Deterministic mode: local mapping runs to quiescence after every frame, in order.
   if (options_.deterministic && result.newKeyFrame) {
     mapper_->runUntilIdle();
@@ -206,6 +209,8 @@ SlamStats SlamCore<Sensor>::stats() const {
   s.keyFrames = map_.keyFrameCount();
   s.mapPoints = map_.mapPointCount();
   s.loopClosures = loopCloser_ ? loopCloser_->closures().size() : 0;
+  s.initialisedAtFrame = initialisedAtFrame_;
+  s.initialisationWaits = tracker_->initialisationWaits();
   return s;
 }
 
