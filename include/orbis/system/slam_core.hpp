@@ -38,21 +38,6 @@ struct SlamOptions {
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
 };
 
-// GATE (remove when Sim(3) loop closing merges, branch sim3): LoopCloser<Sensor> is SE(3) only
-// and static_asserts a metric sensor, so a sensor without metric scale gets this stand-in type,
-// which is never created (SlamCore's constructor leaves the pointer null); it only lets the
-// calls below compile. Merging: make LoopCloserOf<Sensor> LoopCloser<Sensor> and drop the
-// `if constexpr` in SlamCore's constructor.
-struct NoLoopCloser {
-  void insertKeyFrame(KeyFrame*) {}
-  void runUntilIdle() {}
-  void waitUntilIdle() {}
-  void shutdown() {}
-  std::vector<LoopClosureEvent> closures() const { return {}; }
-};
-template <class Sensor>
-using LoopCloserOf = std::conditional_t<Sensor::kMetricScale, LoopCloser<Sensor>, NoLoopCloser>;
-
 struct SlamStats {
   std::size_t frames = 0, tracked = 0, lost = 0, keyFrames = 0, mapPoints = 0;
   std::size_t loopClosures = 0;
@@ -107,9 +92,8 @@ class SlamCore {
   const Camera& camera() const { return camera_; }
   // What the map file records of the camera.
   const MapIntrinsics& intrinsics() const { return intrinsics_; }
-  // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode) and, until
-  // Sim(3) loops merge, for sensors without metric scale.
-  const LoopCloserOf<Sensor>* loopCloser() const { return loopCloser_.get(); }
+  // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode).
+  const LoopCloser<Sensor>* loopCloser() const { return loopCloser_.get(); }
 
  private:
   const Camera camera_;  // every stage below holds a reference to it
@@ -122,7 +106,7 @@ class SlamCore {
   std::unique_ptr<Relocaliser<Sensor>> relocaliser_;
   std::size_t loadedKeyFrames_ = 0;
   std::unique_ptr<LocalMapper<Sensor>> mapper_;
-  std::unique_ptr<LoopCloserOf<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
+  std::unique_ptr<LoopCloser<Sensor>> loopCloser_;  // declared after mapper_: destroyed before it
   std::unique_ptr<Tracker<Sensor>> tracker_;
   std::atomic<std::uint64_t> frames_{0};  // atomic: mapSnapshot() reads it from an observer's thread
   std::uint64_t lost_ = 0;

@@ -18,13 +18,11 @@ SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabu
   LocalMapperOptions mapperOptions;
   mapperOptions.threaded = !options_.deterministic;
   mapper_ = std::make_unique<LocalMapper<Sensor>>(camera_, map_, mapperOptions, &timer_);
-  if constexpr (Sensor::kMetricScale) {  // GATE: Sim(3) loop closing not merged yet (slam_core.hpp)
-    if (options_.loopClosing && !options_.localisationOnly) {
-      LoopCloserOptions loopOptions;
-      loopOptions.threaded = !options_.deterministic;
-      loopOptions.seed = options_.seed;
-      loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);
-    }
+  if (options_.loopClosing && !options_.localisationOnly) {
+    LoopCloserOptions loopOptions;
+    loopOptions.threaded = !options_.deterministic;
+    loopOptions.seed = options_.seed;
+    loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);
   }
   // Processed keyframes feed the keyframe database: through the loop closer (which queries it
   // before adding each one) or directly.
