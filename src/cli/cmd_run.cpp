@@ -138,14 +138,24 @@ void printReport(const RunReport& r, const RunOptions& options, bool json) {
   std::printf("dataset        %s (%s)\n", r.dataset.c_str(), r.sensor.c_str());
   std::printf("frames         %zu  tracked %zu  lost %zu\n", r.stats.frames, r.stats.tracked, r.stats.lost);
   std::printf("map            %zu keyframes, %zu points\n", r.stats.keyFrames, r.stats.mapPoints);
+  if (!r.stats.initialisationWaits.empty() || !r.stats.initialisedAtFrame) {
+    std::string waits;
+    for (const auto& [reason, frames] : r.stats.initialisationWaits)
+      waits += (waits.empty() ? "" : ", ") + reason + " " + std::to_string(frames);
+    if (r.stats.initialisedAtFrame) std::printf("initialised    at frame %llu", static_cast<unsigned long long>(*r.stats.initialisedAtFrame));
+    else std::printf("initialised    never");
+    std::printf("%s%s%s\n", waits.empty() ? "" : " (frames waiting: ", waits.c_str(), waits.empty() ? "" : ")");
+  }
   if (options.loadMap || r.relocalisationAttempts)
     std::printf("relocalised    %zu of %zu attempts; %zu keyframes loaded\n", r.relocalisations,
                 r.relocalisationAttempts, r.keyFramesLoaded);
   if (options.denseCloud && r.densePoints)
     std::printf("dense cloud    %zu points in %s\n", r.densePoints, options.denseCloud->string().c_str());
   if (r.ateRmse)
-    std::printf("ATE (SE3)      %.4f m RMSE over %zu poses (path %.2f m, %.2f%%)\n", *r.ateRmse, r.ateMatched,
-                r.pathLength, r.pathLength > 0 ? 100 * *r.ateRmse / r.pathLength : 0.0);
+    std::printf("ATE (%s)     %.4f m RMSE over %zu poses (path %.2f m, %.2f%%)\n", r.ateAlignment == "sim3" ? "Sim3" : "SE3 ",
+                *r.ateRmse, r.ateMatched, r.pathLength, r.pathLength > 0 ? 100 * *r.ateRmse / r.pathLength : 0.0);
+  if (r.ateKeyFramesRmse)
+    std::printf("  keyframes    %.4f m RMSE over %zu keyframes\n", *r.ateKeyFramesRmse, r.ateKeyFramesMatched);
   std::printf("\n%-32s %7s %9s %9s %9s\n", "stage", "count", "mean ms", "median", "p95");
   for (const StageStats& s : r.timing)
     std::printf("%-32s %7zu %9.2f %9.2f %9.2f\n", s.stage.c_str(), s.count, s.meanMs, s.medianMs, s.p95Ms);

@@ -13,7 +13,7 @@ namespace orbis::cli {
 namespace {
 
 // "START:COUNT" → (start, count).
-std::pair<int, int> parseBlackSegment(const std::string& text) {
+std::pair<int, int> parseSegment(const std::string& text, const std::string& argument) {
   const auto colon = text.find(':');
   std::size_t used1 = 0, used2 = 0;
   int start = -1, count = -1;
@@ -26,7 +26,7 @@ std::pair<int, int> parseBlackSegment(const std::string& text) {
     start = -1;
   }
   if (colon == std::string::npos || used1 != colon || used2 != text.size() - colon - 1 || start < 0 || count < 0)
-    throw Error("argument --black", "", "expected START:COUNT (two non-negative integers), got '" + text + "'");
+    throw Error("argument " + argument, "", "expected START:COUNT (two non-negative integers), got '" + text + "'");
   return {start, count};
 }
 
@@ -47,6 +47,8 @@ int runSynth(const std::vector<std::string>& args) {
       .option("--depth-noise", "SIGMA", "Gaussian noise of the depth's inverse, 1/m (Kinect-like: 0.0014)", "0")
       .option("--blur", "N", "motion blur: sub-frames averaged per frame (1 = none)", "1")
       .option("--black", "START:COUNT", "black out COUNT frames from frame START (relocalisation tests)")
+      .option("--flat", "START:COUNT", "textureless frames (uniform grey plus noise) from frame START")
+      .option("--motion", "loop|rotation|static", "camera motion: the loop, a pure rotation in place, or none", "loop")
       .option("--seed", "S", "seed of the scene, textures and noise", "1")
       .option("--supersample", "N", "rays per pixel along each axis (antialiasing)", "2")
       .option("--threads", "N", "rendering threads", "1")
@@ -75,7 +77,12 @@ int runSynth(const std::vector<std::string>& args) {
   const long seed = p.getInt("--seed");
   if (seed < 0) throw Error("argument --seed", "", "expected a non-negative integer");
   o.seed = static_cast<std::uint64_t>(seed);
-  if (auto black = p.getOptional("--black")) std::tie(o.blackStart, o.blackCount) = parseBlackSegment(*black);
+  if (auto black = p.getOptional("--black")) std::tie(o.blackStart, o.blackCount) = parseSegment(*black, "--black");
+  if (auto flat = p.getOptional("--flat")) std::tie(o.flatStart, o.flatCount) = parseSegment(*flat, "--flat");
+  const std::string motion = p.get("--motion");
+  if (motion == "rotation") o.path.motion = synth::PathMotion::PureRotation;
+  else if (motion == "static") o.path.motion = synth::PathMotion::Static;
+  else if (motion != "loop") throw Error("argument --motion", "", "expected loop, rotation or static, not '" + motion + "'");
   const synth::SynthLayout layout = synth::parseSynthLayout(p.get("--layout"), "argument --layout");
   const bool json = p.has("--json");
 

@@ -5,5 +5,6 @@ namespace orbis {
 
 template class LoopCloser<Stereo>;
 template class LoopCloser<Rgbd>;
+template class LoopCloser<Monocular>;
 
 }  // namespace orbis

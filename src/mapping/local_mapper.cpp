@@ -5,5 +5,6 @@ namespace orbis {
 
 template class LocalMapper<Stereo>;
 template class LocalMapper<Rgbd>;
+template class LocalMapper<Monocular>;
 
 }  // namespace orbis

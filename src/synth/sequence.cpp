@@ -30,6 +30,8 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
   require(options.shutter >= 0.0 && options.shutter <= 1.0, "shutter", "must lie in [0, 1]");
   require(options.blackCount >= 0, "black", "count must not be negative");
   require(options.blackCount == 0 || options.blackStart >= 0, "black", "start must not be negative");
+  require(options.flatCount >= 0, "flat", "count must not be negative");
+  require(options.flatCount == 0 || options.flatStart >= 0, "flat", "start must not be negative");
   require(options.supersample >= 1, "supersample", "must be at least 1");
   scene_ = makeRoomScene(options.room, options.seed);
 }
@@ -58,6 +60,10 @@ bool SyntheticSequence::isBlack(int i) const {
   return options_.blackCount > 0 && i >= options_.blackStart && i < options_.blackStart + options_.blackCount;
 }
 
+bool SyntheticSequence::isFlat(int i) const {
+  return options_.flatCount > 0 && i >= options_.flatStart && i < options_.flatStart + options_.flatCount;
+}
+
 cv::Mat SyntheticSequence::renderImage(int i, const SE3d& leftToCamera, int cameraIndex, cv::Mat* depth) {
   const PinholeCamera<double> cam = camera();
   const int n = options_.blurSubframes;
@@ -73,6 +79,7 @@ cv::Mat SyntheticSequence::renderImage(int i, const SE3d& leftToCamera, int came
     else sum += gray;
   }
   if (n > 1) sum *= 1.0 / n;
+  if (isFlat(i)) sum.setTo(128.0);  // textureless: only the noise is left
   if (depth && n % 2 == 0) {
     // Even sub-frame counts have no sample at the frame's instant: render its depth separately.
     renderer_.render(scene_, cam, pose(i) * leftToCamera, gray, depth);

@@ -70,14 +70,25 @@ void writeReport(const fs::path& file, const RunReport& r) {
   w.field("dataset", r.dataset).field("sensor", r.sensor);
   w.field("frames", r.stats.frames).field("frames_tracked", r.stats.tracked).field("frames_lost", r.stats.lost);
   w.field("keyframes", r.stats.keyFrames).field("map_points", r.stats.mapPoints);
+  // When the map started and, before that, why each frame did not start it.
+  w.key("initialisation").beginObject().key("frame");
+  if (r.stats.initialisedAtFrame) w.value(*r.stats.initialisedAtFrame);
+  else w.null();
+  w.key("waits").beginObject();
+  for (const auto& [reason, frames] : r.stats.initialisationWaits) w.field(reason, frames);
+  w.endObject().endObject();
   w.field("seconds", r.seconds);
   w.field("keyframes_loaded", r.keyFramesLoaded);
   w.field("dense_points", r.densePoints);
   w.field("relocalisation_attempts", r.relocalisationAttempts).field("relocalisations", r.relocalisations);
   w.key("ate");
   if (r.ateRmse) {
-    w.beginObject().field("rmse", *r.ateRmse).field("matched", r.ateMatched).field("alignment", "se3");
-    w.field("path_length", r.pathLength).endObject();
+    w.beginObject().field("rmse", *r.ateRmse).field("matched", r.ateMatched).field("alignment", r.ateAlignment);
+    w.field("path_length", r.pathLength);
+    w.key("keyframes");
+    if (r.ateKeyFramesRmse) w.beginObject().field("rmse", *r.ateKeyFramesRmse).field("matched", r.ateKeyFramesMatched).endObject();
+    else w.null();
+    w.endObject();
   } else {
     w.null();
   }
@@ -87,6 +98,13 @@ void writeReport(const fs::path& file, const RunReport& r) {
     w.field("p95", s.p95Ms).field("max", s.maxMs).endObject();
   }
   w.endObject();
+  // "scale": the current keyframe's map scale over the loop keyframe's (1 for metric sensors).
+  w.key("loops").beginArray();
+  for (const LoopClosureEvent& e : r.loopClosures) {
+    w.beginObject().field("current_keyframe", e.current).field("loop_keyframe", e.loop).field("frame", e.frameIndex);
+    w.field("inliers", e.inliers).field("scale", e.scale).endObject();
+  }
+  w.endArray();
   // Repeated warnings folded (a few of each kind, then a count), as the program prints them.
   const std::vector<WarningKind> kinds = foldWarnings(r.warnings);
   w.key("warnings").beginArray();
@@ -111,20 +129,34 @@ template <>
 RgbdInput makeInput<Rgbd>(const DatasetFrame& f) {
   return {f.timestamp, f.left, f.depth};
 }
+template <>
+MonocularInput makeInput<Monocular>(const DatasetFrame& f) {
+  return {f.timestamp, f.left};
+}
 
 bool inputComplete(const StereoInput& in) { return !in.left.empty() && !in.right.empty(); }
 bool inputComplete(const RgbdInput& in) { return !in.image.empty() && !in.depth.empty(); }
+bool inputComplete(const MonocularInput& in) { return !in.image.empty(); }
+
+// A monocular camera's images may still carry lens distortion; the stereo and RGB-D inputs the
+// runner feeds are rectified or undistorted.
+template <class Sensor>
+Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
+                      std::shared_ptr<const OrbVocabulary> vocabulary, const SlamOptions& options) {
+  if constexpr (Sensor::kKind == SensorKind::Monocular) return Slam<Sensor>(camera, orb, lens, std::move(vocabulary), options);
+  else return Slam<Sensor>(camera, orb, std::move(vocabulary), options);
+}
 
 template <class Sensor>
-void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double fps, DatasetReader& dataset,
-             const RunOptions& options, RunReport& report) {
+void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<double>& lens, const OrbParams& orb,
+             double fps, DatasetReader& dataset, const RunOptions& options, RunReport& report) {
   auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
   SlamOptions slamOptions;
   slamOptions.deterministic = options.deterministic;
   slamOptions.localisationOnly = options.localisationOnly;
   slamOptions.loopClosing = options.loopClosing;
   slamOptions.fps = fps;
-  Slam<Sensor> slam(camera, orb, vocabulary, slamOptions);
+  Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, vocabulary, slamOptions);
   slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {
     slam.core().loadMap(*options.loadMap);
@@ -199,6 +231,7 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report.stats = slam.stats();
   report.timing = slam.timer().summary();
+  if (const auto* closer = slam.core().loopCloser()) report.loopClosures = closer->closures();
 
   fs::create_directories(options.outDir);
   const Trajectory trajectory = slam.trajectory();
@@ -215,7 +248,19 @@ void runWith(const typename Sensor::Camera& camera, const OrbParams& orb, double
   const Trajectory& gt = dataset.groundTruth();
   if (!gt.empty() && !trajectory.empty()) {
     try {
-      const eval::AteResult ate = eval::computeAte(gt, trajectory, {eval::Alignment::SE3, 0.02});
+      // A monocular map's scale is arbitrary: its trajectory is compared up to a similarity.
+      const eval::Alignment alignment = Sensor::kMetricScale ? eval::Alignment::SE3 : eval::Alignment::Sim3;
+      report.ateAlignment = Sensor::kMetricScale ? "se3" : "sim3";
+      const eval::AteResult ate = eval::computeAte(gt, trajectory, {alignment, 0.02});
+      if (!keyFrames.empty()) {
+        try {
+          const eval::AteResult kfAte = eval::computeAte(gt, keyFrames, {alignment, 0.02});
+          report.ateKeyFramesRmse = kfAte.stats.rmse;
+          report.ateKeyFramesMatched = kfAte.stats.count;
+        } catch (const Error& e) {
+          report.warnings.push_back(std::string("keyframe ATE not computed: ") + e.what());
+        }
+      }
       report.ateRmse = ate.stats.rmse;
       report.ateMatched = ate.stats.count;
       for (std::size_t k = 1; k < ate.pairs.size(); ++k)
@@ -264,24 +309,28 @@ RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
   orb.features = defaults.features;
   double fps = defaults.fps;
   DatasetCamera camera;
+  RadTanDistortion<double> lens;
   if (options.settings) {
     const Settings s = Settings::load(*options.settings, dataset.sensor());
     orb = s.orb;
     fps = s.fps;
     camera = std::visit([](const auto& c) -> DatasetCamera { return c; }, s.camera);
+    lens = s.distortion;
   } else {
     camera = dataset.camera();
+    lens = dataset.distortion();
   }
   report.sensor = std::string(toString(dataset.sensor()));
   std::visit(
       [&](const auto& cam) {
         using C = std::decay_t<decltype(cam)>;
         if constexpr (std::is_same_v<C, RectifiedStereoCamera<double>>) {
-          runWith<Stereo>(cam, orb, fps, dataset, options, report);
+          runWith<Stereo>(cam, lens, orb, fps, dataset, options, report);
         } else if constexpr (std::is_same_v<C, RgbdCamera<double>>) {
-          runWith<Rgbd>(cam, orb, fps, dataset, options, report);
+          runWith<Rgbd>(cam, lens, orb, fps, dataset, options, report);
         } else {
-          throw Error("orbis run", "", "monocular SLAM is not available yet: run a stereo or RGB-D sequence");
+          static_assert(std::is_same_v<C, PinholeCamera<double>>);
+          runWith<Monocular>(cam, lens, orb, fps, dataset, options, report);
         }
       },
       camera);

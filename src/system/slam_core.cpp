@@ -5,5 +5,6 @@ namespace orbis {
 
 template class SlamCore<Stereo>;
 template class SlamCore<Rgbd>;
+template class SlamCore<Monocular>;
 
 }  // namespace orbis

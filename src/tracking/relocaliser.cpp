@@ -5,5 +5,6 @@ namespace orbis {
 
 template class Relocaliser<Stereo>;
 template class Relocaliser<Rgbd>;
+template class Relocaliser<Monocular>;
 
 }  // namespace orbis

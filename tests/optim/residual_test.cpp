@@ -4,6 +4,7 @@
 
 #include "orbis/optim/pose_graph_residuals.hpp"
 #include "orbis/optim/reprojection.hpp"
+#include "orbis/optim/sim3_reprojection.hpp"
 
 #include <gtest/gtest.h>
 
@@ -142,6 +143,53 @@ TEST(OptimResiduals, RelativePoseSim3Jacobians) {
   }
   std::printf("RelativePoseSim3 (7x7x7): max relative discrepancy %.3e\n", worst);
   EXPECT_LT(worst, 1e-6);
+}
+
+// A point ahead of a camera at 2–10 units, expressed through `toPoint` (the inverse of the map
+// the residual applies).
+Eigen::Vector3d pointSeenThrough(std::mt19937& rng, const Sim3d& toPoint) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return toPoint * Eigen::Vector3d(u(rng), u(rng), 6.0 + 4.0 * u(rng));
+}
+
+// Loop closing's Sim(3) refinement: camera 1 sees camera 2's points through S12, camera 2 sees
+// camera 1's through S12⁻¹; scales up to e^{±0.9} as a monocular map drifts.
+TEST(OptimResiduals, Sim3ReprojectionJacobians) {
+  const PinholeCamera<double> camera{250.0, 250.0, 160.0, 120.0, 320, 240};
+  std::mt19937 rng(13);
+  double worstDirect = 0.0, worstInverse = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const Sim3d S12 = randomSim3(rng, 0.7, 1.0, 0.3);
+    const MonoSim3Reprojection direct{{150.0, 110.0}, &camera};
+    worstDirect = std::max(worstDirect, test::checkJacobians(direct, S12, pointSeenThrough(rng, S12.inverse())).relative());
+    const MonoInverseSim3Reprojection inverse{{170.0, 100.0}, &camera};
+    worstInverse = std::max(worstInverse, test::checkJacobians(inverse, S12, pointSeenThrough(rng, S12)).relative());
+  }
+  std::printf("Sim3Reprojection (2x7x3): max relative discrepancy %.3e\n", worstDirect);
+  std::printf("InverseSim3Reprojection (2x7x3): max relative discrepancy %.3e\n", worstInverse);
+  EXPECT_LT(worstDirect, 1e-6);
+  EXPECT_LT(worstInverse, 1e-6);
+}
+
+// With scale 1 the Sim(3) residuals are the SE(3) ones: same values, and the first six Jacobian
+// columns equal (the seventh, the scale, is what a monocular loop adds).
+TEST(OptimResiduals, Sim3ReprojectionReducesToSE3AtUnitScale) {
+  const PinholeCamera<double> camera{250.0, 250.0, 160.0, 120.0, 320, 240};
+  std::mt19937 rng(17);
+  const SE3d T12 = randomPose(rng, 0.5, 1.0);
+  const Sim3d S12(T12);
+  const Eigen::Vector3d p2 = pointSeenThrough(rng, S12.inverse()), p1 = pointSeenThrough(rng, S12);
+  Eigen::Vector2d a, b;
+  Eigen::Matrix<double, 2, 7> j7;
+  Eigen::Matrix<double, 2, 6> j6;
+  MonoSim3Reprojection{{150.0, 110.0}, &camera}.evaluate(S12, p2, a, &j7, nullptr);
+  MonoReprojection{{150.0, 110.0}, &camera}.evaluate(T12, p2, b, &j6, nullptr);
+  EXPECT_LT((a - b).norm(), 1e-9);
+  EXPECT_LT((j7.leftCols<6>() - j6).norm(), 1e-9 * j6.norm());
+  MonoInverseSim3Reprojection{{170.0, 100.0}, &camera}.evaluate(S12, p1, a, &j7, nullptr);
+  InversePoseReprojection<PinholeCamera<double>>{{170.0, 100.0}, &camera}.evaluate(T12, p1, b, &j6, nullptr);
+  EXPECT_LT((a - b).norm(), 1e-9);
+  EXPECT_LT((j7.leftCols<6>() - j6).norm(), 1e-9 * j6.norm());
 }
 
 TEST(OptimResiduals, JacobianCheckDetectsAWrongJacobian) {

@@ -17,6 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace orbis;
+using test::identical;
+using test::pathLength;
 
 synth::SynthOptions smallLoop(std::uint64_t seed) {
   synth::SynthOptions o;
@@ -60,19 +62,6 @@ SyntheticRun runSynthetic(const synth::SynthOptions& options, const std::vector<
   run.estimate = slam.trajectory();
   run.stats = slam.stats();
   return run;
-}
-
-double pathLength(const Trajectory& t) {
-  double len = 0;
-  for (std::size_t i = 1; i < t.size(); ++i) len += (t[i].pose.translation() - t[i - 1].pose.translation()).norm();
-  return len;
-}
-
-bool identical(const Trajectory& a, const Trajectory& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (a[i].t != b[i].t || a[i].pose.matrix() != b[i].pose.matrix()) return false;
-  return true;
 }
 
 template <class Sensor>

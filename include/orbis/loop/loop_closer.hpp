@@ -1,17 +1,23 @@
 // orbis/loop/loop_closer.hpp — the loop-closing thread of the paper (§III-D; ORB-SLAM §VII) and
-// its full-BA worker, for metric sensors (stereo, RGB-D: SE(3) loops).
+// its full-BA worker: SE(3) loops for metric sensors (stereo, RGB-D), Sim(3) loops for monocular.
 //
 // Contract: keyframes come from local mapping (insertKeyFrame, the LocalMapper's keyframe sink)
 // and are processed in order. Each is added to the keyframe database; loop candidates are those
 // of bow::KeyframeDatabase::detectLoopCandidates kept only when their covisibility group stays
 // consistent over `consistencyThreshold` consecutive keyframes. For each such candidate: bag-of-
-// words matches, an SE(3) by RANSAC over 3-point alignments (generator seeded by options.seed),
-// guided matching and pose refinement; accepted with ≥ minPoseInliers, then ≥ minLoopMatches
-// after projecting the candidate's neighbourhood. The correction: local mapping paused, the
-// current keyframe and its covisible keyframes (and their points) moved by the loop transform,
-// duplicated points merged, covisibility updated, loop edges added, the essential graph
-// optimised (spanning tree, loop edges, covisibility ≥ essentialGraphMinWeight; the loop
-// keyframe fixed), then full BA. Full BA runs on its own thread in
+// words matches, then the loop transform by RANSAC over 3-point closed forms (generator seeded
+// by options.seed), guided matching both ways and a two-way reprojection refinement; accepted
+// with ≥ minPoseInliers, then ≥ minLoopMatches after projecting the candidate's neighbourhood.
+// A metric sensor's transform is an SE(3) (relative_pose.hpp); a monocular map's is a Sim(3)
+// (sim3_solver.hpp, matching::matchBySim3), whose scale is the drift the loop corrects.
+// The correction: local mapping paused, the current keyframe and its covisible keyframes moved
+// by the loop transform — as a Sim(3) for monocular, their points mapped through their corrected
+// similarity and their poses kept rigid with the scale divided out of t — duplicated points
+// merged, covisibility updated, loop edges added, the essential graph optimised (spanning tree,
+// loop edges, covisibility ≥ essentialGraphMinWeight; the loop keyframe fixed; in Sim(3) for
+// monocular, after which each point follows its corrector's or reference keyframe's similarity),
+// then full BA. Metric sensors never take the Sim(3) path (if constexpr on kMetricScale).
+// Full BA runs on its own thread in
 // threaded mode — aborted and restarted when a new loop closes — and inline in deterministic
 // mode; its result is merged under the map lock with local mapping paused: optimised keyframes
 // take their new poses, keyframes created meanwhile follow their spanning-tree parent, points
@@ -33,9 +39,11 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "orbis/bow/keyframe_database.hpp"
+#include "orbis/geometry/sim3.hpp"
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
 #include "orbis/sensor/sensor.hpp"
@@ -63,13 +71,17 @@ struct LoopClosureEvent {
   KeyFrameId current = 0, loop = 0;
   std::uint64_t frameIndex = 0;  // frame the current keyframe was made from
   int inliers = 0;               // matched points after the projection search
+  // The similarity's scale: the current keyframe's map scale over the loop keyframe's, i.e. the
+  // scale drift the loop corrects (1 for metric sensors).
+  double scale = 1.0;
 };
 
 template <SensorConfiguration Sensor>
 class LoopCloser {
  public:
   using Camera = typename Sensor::Camera;
-  static_assert(Sensor::kMetricScale, "loop closing in SE(3) needs a metric sensor; Sim(3) loops are not available yet");
+  // The loop's correction of a pose: rigid for metric sensors, a similarity for monocular.
+  using Correction = std::conditional_t<Sensor::kMetricScale, SE3d, Sim3d>;
 
   // `camera` must outlive the loop closer (the SLAM system owns it).
   LoopCloser(const Camera& camera, Map& map, LocalMappingControl* mapper, bow::KeyframeDatabase& database,
@@ -96,6 +108,7 @@ class LoopCloser {
   struct LoopCandidate {
     KeyFrame* loopKeyFrame = nullptr;
     SE3d correctedTcw;                  // the current keyframe's pose seen from the loop side
+    Correction correctedScw;            // the same with the loop side's scale (Sim(3) for monocular)
     std::vector<MapPoint*> matches;     // per keypoint of the current keyframe: loop-side point
     std::vector<MapPoint*> loopPoints;  // points of the loop keyframe's neighbourhood
     int matched = 0;
@@ -106,13 +119,18 @@ class LoopCloser {
   void dropBadKeyFrames();
   std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf);
   bool computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out);
+  // One candidate's transform from its bag-of-words matches (ORB-SLAM's ComputeSim3): RANSAC,
+  // guided matching both ways through its result, two-way refinement; SE(3) or Sim(3) by the
+  // sensor. Fills out.loopKeyFrame, the corrected pose and the inlier matches.
+  bool loopTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches, LoopCandidate& out);
   // Takes the map mutex itself (pauses local mapping first):
   void correctLoop(KeyFrame* kf, LoopCandidate& loop);
   using PoseMap = std::map<KeyFrame*, SE3d, ById>;
   using LinkMap = std::map<KeyFrame*, std::set<KeyFrame*, ById>, ById>;
+  using CorrectionMap = std::map<KeyFrame*, Correction, ById>;
   using PointCorrectors = std::map<MapPoint*, KeyFrame*, ById>;
-  void optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected, const LinkMap& loopLinks,
-                              const PointCorrectors& correctedBy);
+  void optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected, const CorrectionMap& corrected,
+                              const LinkMap& loopLinks, const PointCorrectors& correctedBy);
   void startFullBundleAdjustment();
   void runFullBundleAdjustment();
   void stopFullBundleAdjustment();
@@ -152,4 +170,5 @@ class LoopCloser {
 namespace orbis {
 extern template class LoopCloser<Stereo>;
 extern template class LoopCloser<Rgbd>;
+extern template class LoopCloser<Monocular>;
 }  // namespace orbis

@@ -8,6 +8,7 @@
 
 #include "orbis/loop/loop_closer.hpp"
 #include "orbis/loop/relative_pose.hpp"
+#include "orbis/loop/sim3_solver.hpp"
 #include "orbis/map/keyframe_matching.hpp"
 #include "orbis/map/map_covisibility.hpp"
 
@@ -162,6 +163,9 @@ std::vector<KeyFrame*> LoopCloser<Sensor>::detectConsistentCandidates(KeyFrame* 
 
 namespace loop_detail {
 
+// A similarity's camera pose at the scale of the world it maps from: [R | t / s].
+inline SE3d rigidPart(const Sim3d& Scw) { return SE3d(Scw.so3(), Scw.translation() / Scw.scale()); }
+
 inline loop::PointPair makePair(const KeyFrame& kf1, std::size_t i1, const KeyFrame& kf2, std::size_t i2) {
   const Keypoint& k1 = kf1.features().keypointsUn[i1];
   const Keypoint& k2 = kf2.features().keypointsUn[i2];
@@ -191,37 +195,43 @@ inline void pairsFromMatches(const KeyFrame& kf1, const KeyFrame& kf2, const std
   }
 }
 
+// The loop transform's RANSAC and refinement, by the transform's group.
+inline bool ransac(const std::vector<loop::PointPair>& pairs, const PinholeCamera<double>& camera, int minInliers,
+                   std::mt19937& rng, SE3d& T12, std::vector<char>& inliers) {
+  loop::RelativePoseRansacOptions options;
+  options.minInliers = minInliers;
+  loop::RelativePoseEstimate estimate = loop::estimateRelativePoseRansac(pairs, camera, options, rng);
+  T12 = estimate.T12;
+  inliers = std::move(estimate.inliers);
+  return estimate.found;
+}
+inline bool ransac(const std::vector<loop::PointPair>& pairs, const PinholeCamera<double>& camera, int minInliers,
+                   std::mt19937& rng, Sim3d& S12, std::vector<char>& inliers) {
+  loop::Sim3RansacOptions options;
+  options.minInliers = minInliers;
+  loop::Sim3Estimate estimate = loop::estimateSim3Ransac(pairs, camera, options, rng);
+  S12 = estimate.S12;
+  inliers = std::move(estimate.inliers);
+  return estimate.found;
+}
+inline int refine(const std::vector<loop::PointPair>& pairs, const PinholeCamera<double>& camera, SE3d& T12,
+                  std::vector<char>& inliers) {
+  return loop::refineRelativePose(pairs, camera, T12, inliers);
+}
+inline int refine(const std::vector<loop::PointPair>& pairs, const PinholeCamera<double>& camera, Sim3d& S12,
+                  std::vector<char>& inliers) {
+  return loop::refineSim3(pairs, camera, S12, inliers);
+}
+
 }  // namespace loop_detail
 
 template <SensorConfiguration Sensor>
 bool LoopCloser<Sensor>::computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out) {
-  loop::RelativePoseRansacOptions ransac;
-  ransac.minInliers = options_.minPoseInliers;
-  const PinholeCamera<double>& pinhole = pinholeOf(camera_);
-  std::vector<loop::PointPair> pairs;
-  std::vector<std::size_t> index1;
   for (KeyFrame* candidate : candidates) {
     std::vector<MapPoint*> matches;
     const int bowMatches = matching::matchKeyFramesByBow(*kf, *candidate, matches);
     if (bowMatches < options_.minBowMatches) continue;
-    loop_detail::pairsFromMatches(*kf, *candidate, matches, pairs, index1);
-    const loop::RelativePoseEstimate estimate = loop::estimateRelativePoseRansac(pairs, pinhole, ransac, rng_);
-    if (!estimate.found) continue;
-    // Guided matching from the RANSAC inliers, then refinement over every match.
-    std::vector<MapPoint*> guided(kf->size(), nullptr);
-    for (std::size_t k = 0; k < pairs.size(); ++k)
-      if (estimate.inliers[k]) guided[index1[k]] = matches[index1[k]];
-    SE3d T12 = estimate.T12;
-    matching::matchByRelativePose(camera_, *kf, *candidate, T12, guided);
-    loop_detail::pairsFromMatches(*kf, *candidate, guided, pairs, index1);
-    std::vector<char> inliers(pairs.size(), 1);
-    if (loop::refineRelativePose(pairs, pinhole, T12, inliers) < options_.minPoseInliers) continue;
-    out.loopKeyFrame = candidate;
-    out.correctedTcw = T12 * candidate->Tcw();
-    out.matches.assign(kf->size(), nullptr);
-    for (std::size_t k = 0; k < pairs.size(); ++k)
-      if (inliers[k]) out.matches[index1[k]] = guided[index1[k]];
-    break;
+    if (loopTransform(kf, candidate, matches, out)) break;
   }
   if (!out.loopKeyFrame) return false;
   // More matches from the loop keyframe's neighbourhood, seen from the corrected pose.
@@ -238,6 +248,44 @@ bool LoopCloser<Sensor>::computeRelativePose(KeyFrame* kf, const std::vector<Key
   if (out.matched >= options_.minLoopMatches) return true;
   out = LoopCandidate{};
   return false;
+}
+
+template <SensorConfiguration Sensor>
+bool LoopCloser<Sensor>::loopTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches,
+                                       LoopCandidate& out) {
+  const PinholeCamera<double>& pinhole = pinholeOf(camera_);
+  std::vector<loop::PointPair> pairs;
+  std::vector<std::size_t> index1;
+  loop_detail::pairsFromMatches(*kf, *candidate, matches, pairs, index1);
+  Correction T12;  // camera 1 (kf) from camera 2 (candidate)
+  std::vector<char> inliers;
+  if (!loop_detail::ransac(pairs, pinhole, options_.minPoseInliers, rng_, T12, inliers)) return false;
+  // Guided matching from the RANSAC inliers, then refinement over every match.
+  std::vector<MapPoint*> guided(kf->size(), nullptr);
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (inliers[k]) guided[index1[k]] = matches[index1[k]];
+  if constexpr (Sensor::kMetricScale) {
+    matching::matchByRelativePose(camera_, *kf, *candidate, T12, guided);
+  } else {
+    matching::matchBySim3(camera_, *kf, *candidate, T12, guided);
+  }
+  loop_detail::pairsFromMatches(*kf, *candidate, guided, pairs, index1);
+  inliers.assign(pairs.size(), 1);
+  if (loop_detail::refine(pairs, pinhole, T12, inliers) < options_.minPoseInliers) return false;
+  out.loopKeyFrame = candidate;
+  if constexpr (Sensor::kMetricScale) {
+    out.correctedTcw = T12 * candidate->Tcw();
+    out.correctedScw = out.correctedTcw;
+  } else {
+    // The current keyframe's pose in the loop side's world and scale, S_cw = S_cl·T_lw; its
+    // rigid part (t / s) puts the loop side's points in the image, projections being scale-free.
+    out.correctedScw = T12 * Sim3d(candidate->Tcw());
+    out.correctedTcw = loop_detail::rigidPart(out.correctedScw);
+  }
+  out.matches.assign(kf->size(), nullptr);
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (inliers[k]) out.matches[index1[k]] = guided[index1[k]];
+  return true;
 }
 
 }  // namespace orbis

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
+#include <type_traits>
 
 #include "orbis/loop/loop_closer.hpp"
 #include "orbis/map/map_bundle_adjustment.hpp"
@@ -15,6 +17,10 @@
 namespace orbis {
 
 namespace loop_detail {
+
+// A corrected pose as the keyframe stores it: itself, or a similarity's rigid part [R | t / s].
+inline const SE3d& asPose(const SE3d& Tcw) { return Tcw; }
+inline SE3d asPose(const Sim3d& Scw) { return rigidPart(Scw); }
 
 inline MapPoint* followReplacements(MapPoint* p) {
   while (p && p->isBad() && p->replacement()) p = p->replacement();
@@ -42,29 +48,31 @@ void LoopCloser<Sensor>::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
   pauseMapping();
   KeyFrame* loopKf = loop.loopKeyFrame;
   PoseMap nonCorrected;
+  CorrectionMap corrected;
   LinkMap loopLinks;
   PointCorrectors correctedBy;
   {
     std::lock_guard lock(map_.mutex());
     kf->updateConnections();
-    // The current keyframe and its neighbours move rigidly with the loop transform.
+    // The current keyframe and its neighbours move rigidly with the loop transform (metric), or
+    // by the loop's similarity (monocular): S_iw' = T_ic·S_cw', so their scale drift goes too.
     std::vector<KeyFrame*> connected{kf};
     for (KeyFrame* n : kf->covisibles())
       if (!n->isBad()) connected.push_back(n);
     const SE3d Twc = kf->Twc();
-    PoseMap corrected;
     for (KeyFrame* k : connected) {
       nonCorrected[k] = k->Tcw();
-      corrected[k] = k == kf ? loop.correctedTcw : (k->Tcw() * Twc) * loop.correctedTcw;
+      corrected[k] = k == kf ? loop.correctedScw : Correction(k->Tcw() * Twc) * loop.correctedScw;
     }
-    for (const auto& [k, Tcw] : corrected) {
-      const SE3d Twc_corrected = Tcw.inverse();
+    for (const auto& [k, Scw] : corrected) {
+      const Correction Swc_corrected = Scw.inverse();
       const SE3d& Tcw_old = nonCorrected[k];
+      // A point leaves its camera at the old pose and re-enters the world by the correction.
       for (MapPoint* p : k->goodPoints()) {
         if (!correctedBy.emplace(p, k).second) continue;
-        p->setPosition(Twc_corrected * (Tcw_old * p->position()));
+        p->setPosition(Swc_corrected * (Tcw_old * p->position()));
       }
-      k->setPose(Tcw);
+      k->setPose(loop_detail::asPose(Scw));
     }
     for (const auto& [p, k] : correctedBy) p->updateNormalAndDepth();
     for (KeyFrame* k : connected) k->updateConnections();
@@ -102,18 +110,23 @@ void LoopCloser<Sensor>::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
     loopKf->addLoopEdge(kf);
     kf->addLoopEdge(loopKf);
   }
-  optimiseEssentialGraph(kf, loopKf, nonCorrected, loopLinks, correctedBy);
+  optimiseEssentialGraph(kf, loopKf, nonCorrected, corrected, loopLinks, correctedBy);
   anyLoop_ = true;
   lastLoopKeyFrame_ = kf->id;
-  const LoopClosureEvent event{kf->id, loopKf->id, kf->frameIndex, loop.matched};
+  LoopClosureEvent event{kf->id, loopKf->id, kf->frameIndex, loop.matched};
+  if constexpr (!Sensor::kMetricScale) event.scale = loop.correctedScw.scale();
   {
     std::lock_guard lock(eventsMutex_);
     events_.push_back(event);
   }
-  char line[160];
+  char line[200];
   std::snprintf(line, sizeof line, "loop closed: keyframe %llu <-> keyframe %llu (frame %llu), %d inliers",
                 static_cast<unsigned long long>(event.current), static_cast<unsigned long long>(event.loop),
                 static_cast<unsigned long long>(event.frameIndex), event.inliers);
+  if constexpr (!Sensor::kMetricScale) {
+    const std::size_t used = std::strlen(line);
+    std::snprintf(line + used, sizeof line - used, ", Sim(3) scale %.4f", event.scale);
+  }
   report(line);
   resumeMapping();
   if (options_.fullBundleAdjustment) startFullBundleAdjustment();
@@ -121,28 +134,39 @@ void LoopCloser<Sensor>::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
 
 template <SensorConfiguration Sensor>
 void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected,
-                                        const LinkMap& loopLinks, const PointCorrectors& correctedBy) {
+                                                const CorrectionMap& corrected, const LinkMap& loopLinks,
+                                                const PointCorrectors& correctedBy) {
+  using Edge = std::conditional_t<Sensor::kMetricScale, optim::PoseGraphEdgeSE3, optim::PoseGraphEdgeSim3>;
   std::vector<KeyFrame*> keyFrames;
-  std::vector<SE3d> poses, before;
+  std::vector<Correction> poses, before;
   std::vector<char> fixed;
-  std::vector<optim::PoseGraphEdgeSE3> edges;
+  std::vector<Edge> edges;
   {
     std::lock_guard lock(map_.mutex());
     keyFrames = map_.keyFrames();
+    // A keyframe's pose after the loop moved it: its pose for a metric sensor; for monocular the
+    // similarity the correction gave it (its pose alone has lost the scale), else its pose at
+    // scale 1.
+    auto correctedPose = [&](KeyFrame* k) {
+      if constexpr (!Sensor::kMetricScale) {
+        if (const auto it = corrected.find(k); it != corrected.end()) return it->second;
+      }
+      return Correction(k->Tcw());
+    };
     std::map<const KeyFrame*, int> index;
     for (KeyFrame* k : keyFrames) {
       index[k] = static_cast<int>(poses.size());
-      poses.push_back(k->Tcw());
+      poses.push_back(correctedPose(k));
       fixed.push_back(k == loopKf ? 1 : 0);
     }
     before = poses;
     // The pose a keyframe had before the loop moved it: the measurement of its old edges.
     auto oldPose = [&](KeyFrame* k) {
       const auto it = nonCorrected.find(k);
-      return it != nonCorrected.end() ? it->second : k->Tcw();
+      return Correction(it != nonCorrected.end() ? it->second : k->Tcw());
     };
     std::set<std::pair<int, int>> inserted;
-    auto addEdge = [&](KeyFrame* a, KeyFrame* b, const SE3d& Taw, const SE3d& Tbw) {
+    auto addEdge = [&](KeyFrame* a, KeyFrame* b, const Correction& Taw, const Correction& Tbw) {
       const auto ia = index.find(a), ib = index.find(b);
       if (ia == index.end() || ib == index.end()) return;
       const auto key = std::minmax(ia->second, ib->second);
@@ -153,10 +177,10 @@ void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, 
     for (const auto& [k, links] : loopLinks)
       for (KeyFrame* n : links) {
         if ((k != kf || n != loopKf) && k->weight(n) < options_.essentialGraphMinWeight) continue;
-        addEdge(k, n, k->Tcw(), n->Tcw());
+        addEdge(k, n, correctedPose(k), correctedPose(n));
       }
     for (KeyFrame* k : keyFrames) {
-      const SE3d Tkw = oldPose(k);
+      const Correction Tkw = oldPose(k);
       if (KeyFrame* parent = k->parent(); parent && !parent->isBad()) addEdge(k, parent, Tkw, oldPose(parent));
       for (KeyFrame* l : k->loopEdges())
         if (!l->isBad() && l->id < k->id) addEdge(k, l, Tkw, oldPose(l));
@@ -172,7 +196,8 @@ void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, 
   std::map<const KeyFrame*, std::size_t> index;
   for (std::size_t i = 0; i < keyFrames.size(); ++i) index[keyFrames[i]] = i;
   // Points move with the keyframe that last corrected them: the loop's corrector, else their
-  // reference keyframe.
+  // reference keyframe. Through the similarities for monocular: into that keyframe's camera at
+  // the scale it had, back out at the scale the graph gave it.
   for (MapPoint* p : map_.mapPoints()) {
     const auto c = correctedBy.find(p);
     const KeyFrame* ref = c != correctedBy.end() ? c->second : p->reference();
@@ -182,7 +207,7 @@ void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, 
     p->setPosition(poses[i].inverse() * (before[i] * p->position()));
   }
   for (std::size_t i = 0; i < keyFrames.size(); ++i)
-    if (!keyFrames[i]->isBad()) keyFrames[i]->setPose(poses[i]);
+    if (!keyFrames[i]->isBad()) keyFrames[i]->setPose(loop_detail::asPose(poses[i]));
   for (MapPoint* p : map_.mapPoints()) p->updateNormalAndDepth();
 }
 

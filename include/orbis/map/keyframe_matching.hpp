@@ -13,6 +13,8 @@
 //  - matchByRelativePose: with T12 (camera 1 from camera 2), the points of each keyframe are
 //    projected into the other; a pair is kept when both directions agree (ORB-SLAM's
 //    SearchBySim3 with the scale fixed to 1). Existing matches in `matches12` are kept.
+//  - matchBySim3: the same with a similarity S12 (monocular maps: camera 2's map scale taken to
+//    camera 1's); each point's scale-invariance range is checked in its own map's units.
 //  - matchByProjection: `points` projected into keyframe `kf` at pose Tcw (which may differ from
 //    kf.Tcw(): the loop-corrected pose), skipping points already matched in `matches`.
 #pragma once
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "orbis/camera/camera_model.hpp"
+#include "orbis/geometry/sim3.hpp"
 #include "orbis/map/map.hpp"
 
 namespace orbis::matching {
@@ -31,6 +34,10 @@ int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<Ma
 template <CameraModel Camera>
 int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12,
                         std::vector<MapPoint*>& matches12, float radius = 7.5f);
+
+template <CameraModel Camera>
+int matchBySim3(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const Sim3d& S12,
+                std::vector<MapPoint*>& matches12, float radius = 7.5f);
 
 template <CameraModel Camera>
 int matchByProjection(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,

@@ -16,8 +16,11 @@ namespace keyframe_detail {
 
 // Where a point seen from pose Tcw should appear in `kf`, and the pyramid level it predicts;
 // false when it is behind the camera, off the image or outside its scale-invariance range.
-template <CameraModel Camera>
-bool predict(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw, const Eigen::Vector3d& world,
+// Tcw is an SE3d, or a Sim3d taking another keyframe's world (its map scale) into this camera:
+// its inverse's translation is still the camera centre in that world, where the point's scale-
+// invariance distances were measured.
+template <CameraModel Camera, class Pose>
+bool predict(const Camera& camera, const KeyFrame& kf, const Pose& Tcw, const Eigen::Vector3d& world,
              const MapPoint& point, float& u, float& v, int& level, bool checkViewAngle) {
   const Eigen::Vector3d pc = Tcw * world;
   if (pc.z() <= 0) return false;
@@ -77,14 +80,13 @@ inline int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::ve
   return matches;
 }
 
-template <CameraModel Camera>
-int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
-                        float radius) {
-  const SE3d T21 = T12.inverse();
-  const SE3d T1w = kf1.Tcw(), T2w = kf2.Tcw();
-  // Pose of camera 1 (resp. 2) expressed so the other keyframe's world points land in it.
-  const SE3d T1w_via2 = T12 * T2w;  // world (as kf2 sees it) -> camera 1
-  const SE3d T2w_via1 = T21 * T1w;  // world (as kf1 sees it) -> camera 2
+namespace keyframe_detail {
+
+// kf2's points into kf1 through T1w_via2, kf1's into kf2 through T2w_via1; the pairs both
+// directions chose are added to matches12.
+template <CameraModel Camera, class Pose>
+int matchBothWays(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const Pose& T1w_via2,
+                  const Pose& T2w_via1, std::vector<MapPoint*>& matches12, float radius) {
   std::set<MapPoint*, ById> alreadyMatched;
   for (MapPoint* p : matches12)
     if (p) alreadyMatched.insert(p);
@@ -96,8 +98,8 @@ int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFram
     if (!p || p->isBad() || alreadyMatched.count(p)) continue;
     float u, v;
     int level;
-    if (!keyframe_detail::predict(camera, kf1, T1w_via2, p->position(), *p, u, v, level, false)) continue;
-    const long i = keyframe_detail::bestInArea(kf1, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (!predict(camera, kf1, T1w_via2, p->position(), *p, u, v, level, false)) continue;
+    const long i = bestInArea(kf1, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
     if (i >= 0 && !matches12[static_cast<std::size_t>(i)]) match1to2[static_cast<std::size_t>(i)] = static_cast<long>(j);
   }
   // kf1's points into kf2; keep the pairs both directions chose.
@@ -107,13 +109,35 @@ int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFram
     if (!p || p->isBad() || matches12[i] || match1to2[i] < 0) continue;
     float u, v;
     int level;
-    if (!keyframe_detail::predict(camera, kf2, T2w_via1, p->position(), *p, u, v, level, false)) continue;
-    const long j = keyframe_detail::bestInArea(kf2, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (!predict(camera, kf2, T2w_via1, p->position(), *p, u, v, level, false)) continue;
+    const long j = bestInArea(kf2, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
     if (j != match1to2[i]) continue;
     matches12[i] = kf2.point(static_cast<std::size_t>(j));
     ++added;
   }
   return added;
+}
+
+}  // namespace keyframe_detail
+
+template <CameraModel Camera>
+int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12, std::vector<MapPoint*>& matches12,
+                        float radius) {
+  const SE3d T21 = T12.inverse();
+  const SE3d T1w = kf1.Tcw(), T2w = kf2.Tcw();
+  // Pose of camera 1 (resp. 2) expressed so the other keyframe's world points land in it.
+  const SE3d T1w_via2 = T12 * T2w;  // world (as kf2 sees it) -> camera 1
+  const SE3d T2w_via1 = T21 * T1w;  // world (as kf1 sees it) -> camera 2
+  return keyframe_detail::matchBothWays(camera, kf1, kf2, T1w_via2, T2w_via1, matches12, radius);
+}
+
+template <CameraModel Camera>
+int matchBySim3(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const Sim3d& S12,
+                std::vector<MapPoint*>& matches12, float radius) {
+  // Each keyframe's world, at its own map scale, into the other camera.
+  const Sim3d S1w_via2 = S12 * Sim3d(kf2.Tcw());
+  const Sim3d S2w_via1 = S12.inverse() * Sim3d(kf1.Tcw());
+  return keyframe_detail::matchBothWays(camera, kf1, kf2, S1w_via2, S2w_via1, matches12, radius);
 }
 
 template <CameraModel Camera>

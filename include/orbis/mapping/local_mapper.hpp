@@ -108,4 +108,5 @@ class LocalMapper final : public LocalMappingControl {
 namespace orbis {
 extern template class LocalMapper<Stereo>;
 extern template class LocalMapper<Rgbd>;
+extern template class LocalMapper<Monocular>;
 }  // namespace orbis

@@ -254,11 +254,33 @@ bool reprojectionOk(const Camera& camera, const KeyFrame& kf, std::size_t i, con
   return ex * ex + ey * ey + er * er <= 7.8 * sigma2;
 }
 
+// The median depth of the keyframe's map points in its camera (ORB-SLAM's
+// ComputeSceneMedianDepth); 0 without points.
+inline double sceneMedianDepth(const KeyFrame& kf) {
+  const SE3d Tcw = kf.Tcw();
+  std::vector<double> depths;
+  for (const MapPoint* p : kf.points())
+    if (p && !p->isBad()) depths.push_back((Tcw * p->position()).z());
+  if (depths.empty()) return 0;
+  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>((depths.size() - 1) / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  return *middle;
+}
+
+// Monocular maps grow only by triangulation, so ORB-SLAM2 searches twice as many neighbours.
+template <class Sensor>
+std::size_t neighbourCount(int stereoCount) {
+  return static_cast<std::size_t>(Sensor::kMetricScale ? stereoCount : 2 * stereoCount);
+}
+
+// A monocular pair whose baseline is under 1% of the scene depth cannot triangulate reliably.
+inline constexpr double kMinBaselineToDepth = 0.01;
+
 }  // namespace mapping_detail
 
 template <SensorConfiguration Sensor>
 void LocalMapper<Sensor>::createNewMapPoints(KeyFrame* kf) {
-  const auto neighbours = kf->bestCovisibles(static_cast<std::size_t>(options_.triangulationNeighbours));
+  const auto neighbours = kf->bestCovisibles(mapping_detail::neighbourCount<Sensor>(options_.triangulationNeighbours));
   const FrameFeatures& f1 = kf->features();
   const Eigen::Vector3d c1 = kf->cameraCenter();
   const SE3d Tcw1 = kf->Tcw();
@@ -270,7 +292,12 @@ void LocalMapper<Sensor>::createNewMapPoints(KeyFrame* kf) {
   for (KeyFrame* kf2 : neighbours) {
     if (queuedKeyFrames() > 0 && kf2 != neighbours.front()) break;  // ORB-SLAM: yield to new keyframes
     const Eigen::Vector3d c2 = kf2->cameraCenter();
-    if ((c2 - c1).norm() < baseline) continue;  // stereo depth is better than this baseline
+    if constexpr (Sensor::kMetricScale) {
+      if ((c2 - c1).norm() < baseline) continue;  // stereo depth is better than this baseline
+    } else {
+      const double medianDepth = mapping_detail::sceneMedianDepth(*kf2);
+      if (!(medianDepth > 0) || (c2 - c1).norm() / medianDepth < mapping_detail::kMinBaselineToDepth) continue;
+    }
     const auto pairs =
         matching::matchForTriangulation(camera_, *kf, *kf2, mapping_detail::fundamental(camera_, *kf, *kf2), false);
     const FrameFeatures& f2 = kf2->features();
@@ -336,7 +363,7 @@ template <SensorConfiguration Sensor>
 void LocalMapper<Sensor>::fuseWithNeighbours(KeyFrame* kf) {
   std::vector<KeyFrame*> targets;
   std::set<KeyFrame*, ById> seen{kf};
-  for (KeyFrame* n : kf->bestCovisibles(10)) {
+  for (KeyFrame* n : kf->bestCovisibles(mapping_detail::neighbourCount<Sensor>(10))) {
     if (n->isBad() || !seen.insert(n).second) continue;
     targets.push_back(n);
     for (KeyFrame* n2 : n->bestCovisibles(5))

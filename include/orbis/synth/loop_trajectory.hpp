@@ -8,6 +8,9 @@
 // it sees the walls and the boxes in front of them, with sideways parallax), with small pitch
 // and roll oscillations. Every term is a trigonometric polynomial of the phase: the path is
 // infinitely smooth (C-infinity), with no jump at phase 0.
+// Two degenerate motions test what monocular initialisation must refuse: PureRotation stays at
+// the path's phase-0 position and turns one full yaw circle per period (no parallax); Static
+// holds the phase-0 pose.
 #pragma once
 
 #include <cmath>
@@ -19,7 +22,10 @@
 
 namespace orbis::synth {
 
+enum class PathMotion { Loop, PureRotation, Static };
+
 struct LoopTrajectoryParams {
+  PathMotion motion = PathMotion::Loop;
   Eigen::Vector2d centre{0.0, 0.0};
   double radiusX = 2.0, radiusY = 1.5;   // metres
   double height = 1.4;                   // metres above z = 0
@@ -31,12 +37,14 @@ struct LoopTrajectoryParams {
 };
 
 inline SE3d loopPose(const LoopTrajectoryParams& p, double phase) {
-  const double a = 2.0 * M_PI * phase;
+  // Along the loop the whole pose moves with the phase; the degenerate motions freeze it at 0.
+  const double a = p.motion == PathMotion::Loop ? 2.0 * M_PI * phase : 0.0;
+  const double turn = p.motion == PathMotion::PureRotation ? 2.0 * M_PI * phase : 0.0;
   const Eigen::Vector3d position(p.centre.x() + p.radiusX * std::cos(a), p.centre.y() + p.radiusY * std::sin(a),
                                  p.height + p.heightAmplitude * std::sin(2.0 * a + 1.3));
   // Direction of travel of a counter-clockwise ellipse; the outside lies to its right.
   const double heading = std::atan2(p.radiusY * std::cos(a), -p.radiusX * std::sin(a));
-  const double yaw = heading - p.yawOffset + p.yawAmplitude * std::sin(4.0 * a);
+  const double yaw = heading - p.yawOffset + p.yawAmplitude * std::sin(4.0 * a) + turn;
   const double pitch = p.pitchAmplitude * std::sin(3.0 * a);
   const double roll = p.rollAmplitude * std::sin(2.0 * a + 0.7);
   // Camera axes at zero yaw, pitch and roll: looking along world +x, right = -y, down = -z.

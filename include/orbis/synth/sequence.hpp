@@ -42,6 +42,9 @@ struct SynthOptions {
   int blurSubframes = 1;         // 1: no motion blur
   double shutter = 0.5;          // fraction of the frame interval the shutter is open
   int blackStart = -1, blackCount = 0;
+  // Frames flatStart .. flatStart+flatCount-1 see a textureless world: uniform grey (plus the
+  // image noise); depth and pose as rendered.
+  int flatStart = -1, flatCount = 0;
   std::uint64_t seed = 1;
   int supersample = 2;
   int threads = 1;
@@ -76,6 +79,7 @@ class SyntheticSequence {
   SE3d pose(int i) const;               // T_wc, left camera
   SE3d rightPose(int i) const;          // T_wc, right camera
   bool isBlack(int i) const;
+  bool isFlat(int i) const;
 
   SynthFrame render(int i, bool withRight, bool withDepth);
 

@@ -1,11 +1,11 @@
 // orbis/system/dataset_runner.hpp — SLAM over a whole dataset sequence, with its outputs.
 //
 // Contract: runDataset reads the sequence frame by frame through a DatasetReader, picks the
-// compile-time sensor configuration once from the dataset's sensor (Slam<Stereo> or
-// Slam<Rgbd>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
+// compile-time sensor configuration once from the dataset's sensor (Slam<Stereo>, Slam<Rgbd> or
+// Slam<Monocular>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
 // camera-to-world, every tracked frame), keyframes.txt (TUM), report.json (frame counts,
-// keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE when the dataset
-// has ground truth), map.ply (map points) and overview.png (top view); for RGB-D, optionally a
+// keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE of all frames and
+// of the keyframes when the dataset has ground truth, Sim(3)-aligned for monocular, else SE(3)), map.ply (map points) and overview.png (top view); for RGB-D, optionally a
 // dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
 // A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
 // later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
@@ -44,14 +44,19 @@ struct RunReport {
   std::string dataset, sensor;
   SlamStats stats;
   std::vector<StageStats> timing;
-  std::optional<double> ateRmse;  // metres, SE(3) alignment
+  std::optional<double> ateRmse;  // of every tracked frame: metres (monocular: ground-truth units)
   std::size_t ateMatched = 0;
+  std::string ateAlignment = "se3";         // "sim3" for monocular: its map's scale is arbitrary
+  std::optional<double> ateKeyFramesRmse;   // the same for the keyframe trajectory
+  std::size_t ateKeyFramesMatched = 0;
   double pathLength = 0;          // of the ground truth over the matched poses, metres
   std::vector<std::string> warnings;
   double seconds = 0;
   std::size_t keyFramesLoaded = 0;  // from RunOptions::loadMap
   std::size_t densePoints = 0;      // voxels in RunOptions::denseCloud
   std::size_t relocalisationAttempts = 0, relocalisations = 0;
+  // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.
+  std::vector<LoopClosureEvent> loopClosures;
 };
 
 RunReport runDataset(DatasetReader& dataset, const RunOptions& options);

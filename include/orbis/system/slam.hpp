@@ -11,6 +11,7 @@
 #pragma once
 
 #include <chrono>
+#include <concepts>
 #include <memory>
 #include <vector>
 
@@ -29,6 +30,12 @@ class Slam {
   Slam(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
        SlamOptions options = {})
       : builder_(camera, orb), core_(camera, std::move(vocabulary), options) {}
+  // A monocular camera whose images still carry lens distortion (the builder undistorts keypoints).
+  Slam(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
+       std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options = {})
+    requires std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&,
+                                     const RadTanDistortion<double>&>
+      : builder_(camera, orb, lens), core_(camera, std::move(vocabulary), options) {}
 
   TrackResult track(const Input& input) {
     std::shared_ptr<const FrameFeatures> features;
@@ -40,7 +47,12 @@ class Slam {
       features = std::make_shared<const FrameFeatures>(builder_.build(input));
       if (core_.observesFrames()) extractionMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     }
-    return core_.track(std::move(features), input.timestamp, extractionMs, observedImage(input));
+    const TrackResult result = core_.track(std::move(features), input.timestamp, extractionMs, observedImage(input));
+    // A builder with an initialisation budget (monocular) uses it until the map exists, and again
+    // after a reset (sensor.hpp).
+    if constexpr (requires { builder_.setInitialising(true); })
+      builder_.setInitialising(result.state == TrackingState::NotInitialised);
+    return result;
   }
 
   void shutdown() { core_.shutdown(); }

@@ -10,7 +10,11 @@
 
 #include <atomic>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
 #include <vector>
 
 #include "orbis/bow/keyframe_database.hpp"
@@ -37,6 +41,10 @@ struct SlamOptions {
 struct SlamStats {
   std::size_t frames = 0, tracked = 0, lost = 0, keyFrames = 0, mapPoints = 0;
   std::size_t loopClosures = 0;
+  // The frame the map started on (monocular: the second view of the accepted pair), and why the
+  // frames before it did not start it (Tracker::initialisationWaits: reason -> frames).
+  std::optional<std::uint64_t> initialisedAtFrame;
+  std::map<std::string, std::size_t> initialisationWaits;
 };
 
 // Everything after feature extraction: tracking, local mapping, loop closing and relocalisation
@@ -104,6 +112,7 @@ class SlamCore {
   std::unique_ptr<Tracker<Sensor>> tracker_;
   std::atomic<std::uint64_t> frames_{0};  // atomic: mapSnapshot() reads it from an observer's thread
   std::uint64_t lost_ = 0;
+  std::optional<std::uint64_t> initialisedAtFrame_;
   FrameObserver frameObserver_;
   bool shutDown_ = false;
 };
@@ -133,5 +142,6 @@ MapIntrinsics mapIntrinsicsOf(const Camera& camera) {
 namespace orbis {
 extern template class SlamCore<Stereo>;
 extern template class SlamCore<Rgbd>;
+extern template class SlamCore<Monocular>;
 
 }  // namespace orbis

@@ -84,6 +84,7 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     result = tracker_->track(std::move(frame));
   }
   if (result.state == TrackingState::Lost) ++lost_;
+  if (result.state != TrackingState::NotInitialised && !initialisedAtFrame_) initialisedAtFrame_ = frames_ - 1;
   // Deterministic mode: local mapping runs to quiescence after every frame, in order.
   if (options_.deterministic && result.newKeyFrame) {
     mapper_->runUntilIdle();
@@ -208,6 +209,8 @@ SlamStats SlamCore<Sensor>::stats() const {
   s.keyFrames = map_.keyFrameCount();
   s.mapPoints = map_.mapPointCount();
   s.loopClosures = loopCloser_ ? loopCloser_->closures().size() : 0;
+  s.initialisedAtFrame = initialisedAtFrame_;
+  s.initialisationWaits = tracker_->initialisationWaits();
   return s;
 }
 

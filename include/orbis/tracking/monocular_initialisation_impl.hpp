@@ -89,6 +89,7 @@ bool Tracker<Sensor>::initialiseFromTwoViews(FrameT& f)
   const auto minKeypoints = static_cast<std::size_t>(options_.minInitialisationKeypoints);
   if (!initialReference_ || f.size() <= minKeypoints) {
     initialReference_.reset();
+    ++initialisationWaits_[f.size() > minKeypoints ? "new reference frame" : "too few keypoints"];
     if (f.size() > minKeypoints) {
       initialReference_ = f;
       initialPredicted_.clear();
@@ -103,6 +104,7 @@ bool Tracker<Sensor>::initialiseFromTwoViews(FrameT& f)
                                                         tracking_detail::kInitialisationMatchRatio, true, matches12);
   if (matched < options_.minInitialisationMatches) {
     initialisationRefusal_ = TwoViewRefusal::TooFewMatches;
+    ++initialisationWaits_[std::string(toString(initialisationRefusal_))];
     initialReference_.reset();
     return false;
   }
@@ -120,7 +122,10 @@ bool Tracker<Sensor>::initialiseFromTwoViews(FrameT& f)
   }
   const TwoViewResult twoView = initialiseTwoView(matches, f.camera->K(), initialisationRng_);
   initialisationRefusal_ = twoView.refusal;
-  if (!twoView.accepted()) return false;
+  if (!twoView.accepted()) {
+    ++initialisationWaits_[std::string(toString(initialisationRefusal_))];
+    return false;
+  }
   return createInitialMap(f, pairs, twoView);
 }
 
@@ -135,6 +140,7 @@ bool Tracker<Sensor>::createInitialMap(FrameT& f, const std::vector<std::pair<st
   const double median = tracking_detail::medianDepth(pair.points);
   if (!(median > 0) || pair.points.size() < tracking_detail::kMinInitialMapPoints) {
     initialisationRefusal_ = TwoViewRefusal::TooFewTriangulated;  // ORB-SLAM: "wrong initialization"
+    ++initialisationWaits_[std::string(toString(initialisationRefusal_))];
     initialReference_.reset();
     return false;
   }

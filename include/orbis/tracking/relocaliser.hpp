@@ -103,4 +103,5 @@ class Relocaliser {
 namespace orbis {
 extern template class Relocaliser<Stereo>;
 extern template class Relocaliser<Rgbd>;
+extern template class Relocaliser<Monocular>;
 }  // namespace orbis

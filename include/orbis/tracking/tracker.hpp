@@ -16,11 +16,14 @@
 // depth from a sensor), the stereo checks, and which keypoints may be lifted from depth.
 // Bodies: tracker_impl.hpp; Tracker<Stereo>, Tracker<Rgbd> and Tracker<Monocular> are compiled
 // in src/tracking/.
-// Monocular: initialisation only so far; tracking after it runs the shared path, but local
-// mapping, loop closing and Slam<Monocular> are not there yet.
+// Monocular differs in its keyframe rule (no close points; a keyframe when tracking keeps under
+// 90% of the reference keyframe's points, never while mapping is busy) and has no depth to lift
+// points from: its map grows by the local mapper's triangulation.
 #pragma once
 
 #include <functional>
+#include <map>
+#include <string>
 #include <optional>
 #include <random>
 #include <vector>
@@ -90,6 +93,10 @@ class Tracker {
   TrackingState state() const { return state_; }
   // Why the last monocular initialisation attempt was refused (None before any attempt).
   TwoViewRefusal initialisationRefusal() const { return initialisationRefusal_; }
+  // Why each frame before the map existed did not start it (monocular): reason -> frames. The
+  // reasons: "too few keypoints" (no reference frame: a textureless or blank view), "new
+  // reference frame", or a TwoViewRefusal's name ("too few matches", "low parallax", ...).
+  const std::map<std::string, std::size_t>& initialisationWaits() const { return initialisationWaits_; }
   void setLocalisationOnly(bool on) { options_.localisationOnly = on; }
   bool localisationOnly() const { return options_.localisationOnly; }
   // Every tracked frame, by index. Read with the map mutex held (poses move with the map).
@@ -168,6 +175,7 @@ class Tracker {
   std::vector<Eigen::Vector2f> initialPredicted_;
   std::mt19937 initialisationRng_{options_.initialisationSeed};
   TwoViewRefusal initialisationRefusal_ = TwoViewRefusal::None;
+  std::map<std::string, std::size_t> initialisationWaits_;
 };
 
 }  // namespace orbis

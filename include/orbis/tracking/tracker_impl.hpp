@@ -434,15 +434,20 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
   note("reference_tracked", referenceMatches);
   note("mapper_idle", mapperIdle);
   note("mapper_queue", mapper_ ? static_cast<double>(mapper_->queuedKeyFrames()) : 0.0);
-  const float refRatio = keyFrames < 2 ? 0.4f : 0.75f;
+  // Monocular (ORB-SLAM2): no close points, and a keyframe as soon as tracking sees 10% fewer
+  // points than the reference keyframe, since only keyframe pairs make new points; but never
+  // while mapping is busy, since a queued keyframe has no points of its own to track against.
+  float refRatio = keyFrames < 2 ? 0.4f : 0.75f;
+  if constexpr (!Sensor::kMetricScale) refRatio = 0.9f;
   const bool c1a = current_.index >= lastKeyFrameFrame_ + maxFrames;
   const bool c1b = current_.index >= lastKeyFrameFrame_ + static_cast<std::uint64_t>(options_.minFramesBetweenKeyFrames) && mapperIdle;
-  const bool c1c = matchesInliers_ < referenceMatches * 0.25f || needClose;
+  const bool c1c = Sensor::kMetricScale && (matchesInliers_ < referenceMatches * 0.25f || needClose);
   const bool c2 = (matchesInliers_ < referenceMatches * refRatio || needClose) && matchesInliers_ > 15;
   if (!((c1a || c1b || c1c) && c2)) return false;
   note("keyframe_wanted", 1);
   if (mapperIdle) return true;
   if (mapper_) mapper_->interruptBundleAdjustment();
+  if constexpr (!Sensor::kMetricScale) return false;
   return mapper_ && mapper_->queuedKeyFrames() < 3;
 }
 
