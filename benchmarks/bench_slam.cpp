@@ -82,7 +82,12 @@ void runSequence(benchmark::State& state, DatasetKind kind, const char* folder, 
     state.SkipWithError((std::string(folder) + " not found under ORBIS_DATA").c_str());
     return;
   }
-  const auto camera = std::get<typename Sensor::Camera>(data.reader->camera());
+  // Monocular runs on the colour/left camera's pinhole of the same sequence.
+  const typename Sensor::Camera camera = [&]() -> typename Sensor::Camera {
+    if constexpr (Sensor::kKind == SensorKind::Monocular)
+      return std::visit([](const auto& c) { return pinholeOf(c); }, data.reader->camera());
+    else return std::get<typename Sensor::Camera>(data.reader->camera());
+  }();
   OrbParams orb;
   orb.features = features;
   std::vector<double> perFrameMs;
@@ -95,6 +100,7 @@ void runSequence(benchmark::State& state, DatasetKind kind, const char* folder, 
     for (const DatasetFrame& f : data.frames) {
       typename Sensor::Input input;
       if constexpr (std::is_same_v<Sensor, Rgbd>) input = {f.timestamp, f.left, f.depth};
+      else if constexpr (std::is_same_v<Sensor, Monocular>) input = {f.timestamp, f.left};
       else input = {f.timestamp, f.left, f.right};
       const auto t0 = std::chrono::steady_clock::now();
       slam.track(input);
@@ -103,7 +109,8 @@ void runSequence(benchmark::State& state, DatasetKind kind, const char* folder, 
     slam.shutdown();
   }
   const Summary s = summarise(perFrameMs);
-  const std::string key = std::string(folder) + (deterministic ? " deterministic" : " threaded");
+  const std::string key = std::string(folder) + (Sensor::kKind == SensorKind::Monocular ? " mono" : "") +
+                          (deterministic ? " deterministic" : " threaded");
   gSlam[key] = s;
   state.counters["median_ms"] = s.medianMs;
   state.counters["p95_ms"] = s.p95Ms;
@@ -141,6 +148,7 @@ constexpr const char* kKitti = "kitti_06_first51";
 
 void BM_TeddyRgbdThreaded(benchmark::State& s) { runSequence<Rgbd>(s, DatasetKind::TumRgbd, kTeddy, 1000, 30, false); }
 void BM_TeddyRgbdDeterministic(benchmark::State& s) { runSequence<Rgbd>(s, DatasetKind::TumRgbd, kTeddy, 1000, 30, true); }
+void BM_TeddyMonoThreaded(benchmark::State& s) { runSequence<Monocular>(s, DatasetKind::TumRgbd, kTeddy, 1000, 30, false); }
 void BM_TeddyCvOrb(benchmark::State& s) { runCvOrb(s, DatasetKind::TumRgbd, kTeddy, 1000); }
 void BM_EurocStereoThreaded(benchmark::State& s) { runSequence<Stereo>(s, DatasetKind::Euroc, kEuroc, 1200, 20, false); }
 void BM_EurocCvOrb(benchmark::State& s) { runCvOrb(s, DatasetKind::Euroc, kEuroc, 1200); }
@@ -150,6 +158,7 @@ void BM_KittiCvOrb(benchmark::State& s) { runCvOrb(s, DatasetKind::Kitti, kKitti
 BENCHMARK(BM_TeddyCvOrb)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_TeddyRgbdThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_TeddyRgbdDeterministic)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_TeddyMonoThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_EurocCvOrb)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_EurocStereoThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_KittiCvOrb)->Unit(benchmark::kMillisecond)->Iterations(3);
