@@ -60,7 +60,7 @@ TEST(Settings, EveryShippedFileLoads) {
         s.camera);
     ++count;
   }
-  EXPECT_EQ(count, 5);
+  EXPECT_EQ(count, 6);  // EuRoC, KITTI00-02, KITTI04-12, TUM1-3
 }
 
 TEST(Settings, TumFilesAreRgbdWithVirtualBaseline) {
