@@ -46,6 +46,7 @@
 #include "orbis/geometry/sim3.hpp"
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
+#include "orbis/map/slam_events.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/util/queue_worker.hpp"
 #include "orbis/util/timing.hpp"
@@ -67,14 +68,6 @@ struct LoopCloserOptions {
   std::function<void(const std::string&)> log;
 };
 
-struct LoopClosureEvent {
-  KeyFrameId current = 0, loop = 0;
-  std::uint64_t frameIndex = 0;  // frame the current keyframe was made from
-  int inliers = 0;               // matched points after the projection search
-  // The similarity's scale: the current keyframe's map scale over the loop keyframe's, i.e. the
-  // scale drift the loop corrects (1 for metric sensors).
-  double scale = 1.0;
-};
 
 template <SensorConfiguration Sensor>
 class LoopCloser {

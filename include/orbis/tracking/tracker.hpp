@@ -33,14 +33,13 @@
 #include "orbis/map/frame.hpp"
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
+#include "orbis/map/slam_events.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/util/timing.hpp"
 
 namespace orbis {
 
 
-enum class TrackingState { NotInitialised, Ok, Lost };
-const char* toString(TrackingState s);
 
 struct TrackerOptions {
   int closeTrackedThreshold = 100;   // τt: fewer tracked close points than this …
@@ -64,9 +63,6 @@ struct TrackResult {
   bool newKeyFrame = false;
 };
 
-// What became of one keypoint of the last frame: matched to a map point, the seed of a new map
-// point (a new keyframe's or the first map's), rejected by motion-only BA, or left unmatched.
-enum class KeypointState : std::uint8_t { Unmatched, Matched, New, Outlier };
 
 // A tracked frame, stored relative to its reference keyframe.
 struct TrackedFrame {

@@ -23,8 +23,8 @@
 
 #include "orbis/features/frame_features.hpp"
 #include "orbis/geometry/se3.hpp"
-#include "orbis/loop/loop_closer.hpp"
-#include "orbis/tracking/tracker.hpp"
+#include "orbis/map/map.hpp"
+#include "orbis/map/slam_events.hpp"
 
 namespace orbis {
 
