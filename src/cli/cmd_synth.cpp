@@ -64,8 +64,15 @@ int runSynth(const std::vector<std::string>& args) {
   o.frames = positiveInt("--frames");
   if (p.getInt("--extra") < 0) throw Error("argument --extra", "", "must be 0 or positive");
   o.extraFrames = static_cast<int>(p.getInt("--extra"));
-  o.width = positiveInt("--width");
-  o.height = positiveInt("--height");
+  // A smaller render holds no ORB keypoint at all (each needs a 19-pixel border and a 31-pixel
+  // patch), so SLAM on it could only fail later with a vaguer message.
+  const auto imageSide = [&](const std::string& name) {
+    const int v = positiveInt(name);
+    if (v < 64) throw Error("argument " + name, "", "expected at least 64 pixels: ORB finds no keypoint in a smaller image");
+    return v;
+  };
+  o.width = imageSide("--width");
+  o.height = imageSide("--height");
   o.fx = p.getDouble("--fx");
   o.baseline = p.getDouble("--baseline");
   o.fps = p.getDouble("--fps");
