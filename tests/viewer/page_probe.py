@@ -15,6 +15,8 @@ import base64
 import fcntl
 import json
 import os
+import re
+import signal
 import select
 import shutil
 import subprocess
@@ -85,6 +87,84 @@ class Chromium:
             self.process.wait()
 
 
+def process_tree_cpu(root_pid):
+    """CPU seconds (user + system) of root_pid and its descendants, summed by Chromium --type."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    parents, cpu, kinds = {}, {}, {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % entry) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            with open("/proc/%s/cmdline" % entry, "rb") as f:
+                argv = f.read().split(b"\0")
+        except OSError:
+            continue
+        pid = int(entry)
+        parents[pid] = int(fields[1])
+        cpu[pid] = (int(fields[11]) + int(fields[12])) / ticks  # utime, stime
+        # Chromium rewrites its children's titles: the arguments may come as one string.
+        kind = re.search(rb"--type=([\w-]+)", b" ".join(argv))
+        kinds[pid] = kind.group(1).decode() if kind else "browser"
+    by_kind, by_thread = {}, {}
+    for pid in cpu:
+        ancestor = pid
+        while ancestor not in (root_pid, 0, 1) and ancestor in parents:
+            ancestor = parents[ancestor]
+        if ancestor != root_pid:
+            continue
+        by_kind[kinds[pid]] = round(by_kind.get(kinds[pid], 0) + cpu[pid], 3)
+        for name, seconds in thread_cpu(pid, ticks).items():
+            key = "%s/%s" % (kinds[pid], name)
+            by_thread[key] = round(by_thread.get(key, 0) + seconds, 3)
+    busiest = dict(sorted(((k, v) for k, v in by_thread.items() if v >= 0.05), key=lambda x: -x[1]))
+    return by_kind, busiest
+
+
+def thread_cpu(pid, ticks):
+    """CPU seconds of a process's threads by name (numbered workers summed)."""
+    seconds = {}
+    try:
+        tasks = os.listdir("/proc/%d/task" % pid)
+    except OSError:
+        return seconds
+    for task in tasks:
+        try:
+            with open("/proc/%d/task/%s/stat" % (pid, task)) as f:
+                head, tail = f.read().rsplit(")", 1)
+        except OSError:
+            continue
+        name = re.sub(r"\d+$", "", head.split("(", 1)[1])
+        fields = tail.split()
+        seconds[name] = seconds.get(name, 0) + (int(fields[11]) + int(fields[12])) / ticks
+    return seconds
+
+
+def top_functions(profile, count=15):
+    """The functions with the most self time in a Profiler.stop profile: [(ms, name url:line)]."""
+    nodes = {n["id"]: n for n in profile["nodes"]}
+    self_us = {}
+    deltas = profile.get("timeDeltas", [])
+    for sample, delta in zip(profile.get("samples", []), deltas[1:] + [0]):
+        self_us[sample] = self_us.get(sample, 0) + delta
+    by_name = {}
+    for node_id, us in self_us.items():
+        frame = nodes[node_id]["callFrame"]
+        name = "%s %s:%d" % (frame["functionName"] or "(anonymous)", frame["url"].rsplit("/", 1)[-1],
+                             frame["lineNumber"] + 1)
+        by_name[name] = by_name.get(name, 0) + us
+    return [(round(us / 1000, 1), name) for name, us in sorted(by_name.items(), key=lambda x: -x[1])[:count]]
+
+
+class Stopped(Exception):
+    """SIGTERM: stop waiting, but still report, write the metrics and close the browser."""
+
+
+def stop_on_sigterm(signum, frame):
+    raise Stopped()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("url")
@@ -93,9 +173,12 @@ def main():
     parser.add_argument("--screenshot", help="PNG file")
     parser.add_argument("--requests", help="file: every URL the page requested, one a line")
     parser.add_argument("--timeout", type=float, default=120)
+    parser.add_argument("--poll", type=float, default=0.2, help="seconds between two checks of --until")
     parser.add_argument("--settle", type=float, default=0.5, help="seconds between the condition and the shot")
     parser.add_argument("--size", default="1400x800")
     parser.add_argument("--chromium", default=shutil.which("chromium") or shutil.which("chromium-browser"))
+    parser.add_argument("--metrics", help="JSON file: the page's Performance metrics and the browser's CPU")
+    parser.add_argument("--js-profile", action="store_true", help="with --metrics: sample JavaScript (Profiler)")
     parser.add_argument("--chromium-arg", action="append", default=[], help="one more Chromium flag (repeatable)")
     args = parser.parse_args()
     width, height = map(int, args.size.split("x"))
@@ -107,18 +190,37 @@ def main():
         session = browser.call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
         browser.call("Network.enable", session=session)
         browser.call("Page.enable", session=session)
+        if args.metrics:
+            browser.call("Performance.enable", session=session)
+            if args.js_profile:
+                browser.call("Profiler.enable", session=session)
+                browser.call("Profiler.start", session=session)
         browser.call("Page.navigate", {"url": args.url}, session=session)
         deadline = time.monotonic() + args.timeout
-        while time.monotonic() < deadline:
-            result = browser.call("Runtime.evaluate", {"expression": "Boolean(%s)" % args.until, "returnByValue": True},
-                                  session=session)
-            if result.get("result", {}).get("value") is True:
-                held = True
-                break
-            time.sleep(0.2)
-        time.sleep(args.settle)
+        signal.signal(signal.SIGTERM, stop_on_sigterm)
+        try:
+            while time.monotonic() < deadline:
+                result = browser.call("Runtime.evaluate", {"expression": "Boolean(%s)" % args.until,
+                                                           "returnByValue": True}, session=session)
+                if result.get("result", {}).get("value") is True:
+                    held = True
+                    break
+                time.sleep(args.poll)
+            time.sleep(args.settle)
+        except Stopped:
+            pass
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
         report = browser.call("Runtime.evaluate", {"expression": args.report, "returnByValue": True}, session=session)
         print(report.get("result", {}).get("value"))
+        if args.metrics:
+            metrics = browser.call("Performance.getMetrics", session=session)["metrics"]
+            by_kind, by_thread = process_tree_cpu(browser.process.pid)
+            result = {"page": {m["name"]: m["value"] for m in metrics}, "cpu_seconds": by_kind,
+                      "cpu_seconds_by_thread": by_thread}
+            if args.js_profile:
+                result["js_self_ms"] = top_functions(browser.call("Profiler.stop", session=session)["profile"])
+            with open(args.metrics, "w") as f:
+                json.dump(result, f, indent=1)
         if args.screenshot:
             shot = browser.call("Page.captureScreenshot", {"format": "png"}, session=session)
             with open(args.screenshot, "wb") as f:

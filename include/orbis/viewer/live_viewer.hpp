@@ -7,7 +7,9 @@
 // frame into a message at most frameRateHz times a second (with its image scaled down and JPEG-
 // encoded there, never on the tracking thread; the frames in between are dropped, and no new
 // frame is encoded while no browser has been sent the previous one) and takes a map snapshot at
-// mapRateHz, and only while a browser is connected. Each browser gets the newest message of each kind: a
+// mapRateHz, and only while a browser is connected. Map messages carry what changed since the
+// previous one (src/viewer/map_delta.hpp); a browser that joins late, or lags further behind than
+// the recent changes kept, is sent the whole map instead. Each browser gets the newest frame: a
 // slow or vanished browser misses updates, never delays tracking. detach() or show() publish a
 // final map, which the page keeps showing until the viewer is destroyed. The constructor throws
 // orbis::Error when the port cannot be bound; the destructor stops the server and threads.
