@@ -13,7 +13,8 @@
 # Runs threaded (as in real time). Per run, from report.json: medians of ORB extraction, of the
 # tracking stages ("tracking: total") and of the observer's per-frame copy ("tracking: observer",
 # only with the viewer), their sum; the CPU seconds of the whole orbis process; with Chromium,
-# the CPU seconds of all its processes during the run (page_probe.py --metrics). On a shared,
+# the CPU seconds of all its processes from loading the page to the end of the run
+# (page_probe.py --metrics). On a shared,
 # loaded machine single runs move by tens of percent: the summary compares the best run of each
 # kind (the least disturbed), the medians of the runs, and the median CPU seconds; each run with
 # the viewer also prints what the viewer's publisher thread did.
@@ -48,25 +49,33 @@ run() {  # run NAME BINARY [orbis args...]: CPU seconds (user + system) into NAM
 
 with_viewer() {  # with_viewer NAME BINARY: the browser's CPU seconds into NAME.browser
   local name=$1 binary=$2
-  rm -f "$work/$name.metrics"
-  run "$name" "$binary" --viewer "$port" &
-  local pid=$! reader=""
-  for _ in $(seq 50); do curl -s -m 1 -o /dev/null "http://127.0.0.1:$port/" && break; sleep 0.1; done
+  rm -f "$work/$name.metrics" "$work/ready"
+  local pid reader
   if [[ $client == chromium ]]; then
-    # Stays on the page, rendering, until orbis has finished; SIGTERM then makes it write what
-    # the browser's processes used and close the browser (--dump-dom would leave after the
-    # first messages). It checks the page once a second, to add little of its own.
+    # The browser is started first, as a person opens it before the run: its own start-up is not
+    # the viewer's cost (it is left out of its CPU seconds too). It loads the page as soon as
+    # orbis serves it and stays on it, rendering, until orbis has finished; SIGTERM then makes
+    # it write what its processes used and close (--dump-dom would leave after the first
+    # messages). It checks the page once a second, to add little of its own.
     python3 "$root/tests/viewer/page_probe.py" "http://127.0.0.1:$port/" --until "window.orbisScene.live === false" \
-      --timeout 300 --poll 1 --metrics "$work/$name.metrics" >/dev/null 2>&1 &
+      --timeout 300 --poll 1 --ready-file "$work/ready" --metrics "$work/$name.metrics" >/dev/null 2>&1 &
+    reader=$!
+    for _ in $(seq 300); do [[ -e $work/ready ]] && break; sleep 0.1; done
+    run "$name" "$binary" --viewer "$port" &
+    pid=$!
   else
+    run "$name" "$binary" --viewer "$port" &
+    pid=$!
+    for _ in $(seq 50); do curl -s -m 1 -o /dev/null "http://127.0.0.1:$port/" && break; sleep 0.1; done
     curl -s -N -m 300 "http://127.0.0.1:$port/events" >"$work/events.txt" &
+    reader=$!
   fi
-  reader=$!
   wait "$pid"
   kill "$reader" 2>/dev/null || true
   wait "$reader" 2>/dev/null || true
   if [[ -s $work/$name.metrics ]]; then
-    python3 -c "import json,sys; print('%.2f' % sum(json.load(open(sys.argv[1]))['cpu_seconds'].values()))" \
+    python3 -c "import json,sys; m=json.load(open(sys.argv[1]))
+print('%.2f' % (sum(m['cpu_seconds'].values()) - sum(m['cpu_seconds_before_page'].values())))" \
       "$work/$name.metrics" >"$work/$name.browser"
   else
     echo "-" >"$work/$name.browser"
@@ -108,7 +117,7 @@ for k in kinds[1:]:
     print("median CPU of the orbis run: %.2f s without, %.2f s with %s (%+.1f%%)" % (a, b, label[k], 100 * (b - a) / a))
     browser = [float(r[2]) for r in runs[k] if r[2] != "-"]
     if browser:
-        print("median CPU of the browser during a run with %s: %.2f s (all its processes)"
+        print("median CPU of the browser during a run with %s: %.2f s (all its processes, page load on)"
               % (label[k], statistics.median(browser)))
 PY
 [[ $client == chromium ]] || echo "(viewer client: curl; $(grep -c '^event:' "$work/events.txt" 2>/dev/null || echo 0) events in the last run)"

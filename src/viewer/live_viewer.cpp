@@ -27,9 +27,9 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 // What the browsers are sent. Frames: only the newest one, numbered; a browser that lags skips
-// frames. Maps: numbered changes (map_delta.hpp) that a browser must get in order; the last
-// kMapDeltasKept of them are kept, and a browser that joins or lags further behind gets the
-// whole map instead (encoder.full()). Readers (one per browser) wait for what they have not been
+// frames. Maps: a browser first gets the whole map (encoder.full()), then the numbered changes
+// (map_delta.hpp) in order; the last kMapDeltasKept of them are kept, and a browser that lags
+// further behind gets the whole map again. Readers (one per browser) wait for what they have not been
 // sent; writers never wait for readers.
 class Outbox {
  public:
@@ -81,11 +81,12 @@ class Outbox {
     }
     if (newestMap_ <= seen.map) return nullptr;
     kind = kMap;
-    for (const auto& [seq, message] : mapDeltas_)
-      if (seq == seen.map + 1) {
-        seen.map = seq;
-        return message;
-      }
+    if (seen.map > 0)  // a page that has a map: the next change, while it is kept
+      for (const auto& [seq, message] : mapDeltas_)
+        if (seq == seen.map + 1) {
+          seen.map = seq;
+          return message;
+        }
     lock.unlock();  // the encoder has its own lock; building the whole map takes a while
     MapDeltaEncoder::Message whole = encoder_.full();
     seen.map = whole.seq;
@@ -128,6 +129,7 @@ struct LiveViewer::Impl {
   std::mutex mutex;  // guards the fields below
   std::condition_variable wake;
   std::optional<FrameSnapshot> pendingFrame;
+  RecentTimings recentTimings;       // of every frame, for the medians the page shows
   std::vector<MapPointId> localMap;  // of the newest frame
   bool stopping = false;
   std::mutex sourceMutex;  // held while a snapshot is taken: detach() waits for it, onFrame() never
@@ -141,14 +143,14 @@ struct LiveViewer::Impl {
   void streamEvents(httplib::Response& response);
   void publishLoop();
   void publishMap(const MapSnapshot& map, bool live);
-  std::string frameMessageOf(FrameSnapshot& frame) const;
+  std::string frameMessageOf(FrameSnapshot& frame, const FrameTimingMedians& medians) const;
 };
 
 // The frame's message with its image; the image reference is let go here, on this thread.
-std::string LiveViewer::Impl::frameMessageOf(FrameSnapshot& frame) const {
+std::string LiveViewer::Impl::frameMessageOf(FrameSnapshot& frame, const FrameTimingMedians& medians) const {
   const std::string jpeg = jpegBase64(frame.image, options.imageMaxWidth, options.jpegQuality);
   frame.image.release();
-  return frameMessage(frame, jpeg);
+  return frameMessage(frame, jpeg, medians);
 }
 
 void LiveViewer::Impl::serveRoutes() {
@@ -230,8 +232,9 @@ void LiveViewer::Impl::publishLoop() {
       FrameSnapshot frame = std::move(*pendingFrame);
       pendingFrame.reset();
       localMap = std::move(frame.localMapPoints);
+      const FrameTimingMedians medians = recentTimings.medians();
       lock.unlock();
-      std::string message = frameMessageOf(frame);
+      std::string message = frameMessageOf(frame, medians);
       countMessage(false, message.size());
       messages.publishFrame(std::move(message));
       lock.lock();
@@ -298,6 +301,7 @@ void LiveViewer::onFrame(FrameSnapshot&& frame) {
   {
     std::lock_guard lock(impl_->mutex);
     dropped.swap(impl_->pendingFrame);
+    impl_->recentTimings.add(frame.extractionMs, frame.trackingMs);
     impl_->pendingFrame.emplace(std::move(frame));
   }
 }
@@ -311,7 +315,8 @@ void LiveViewer::detach(MapSnapshot finalMap) {
     std::lock_guard lock(impl_->mutex);
     if (impl_->pendingFrame) {
       impl_->localMap = std::move(impl_->pendingFrame->localMapPoints);
-      impl_->messages.publishFrame(impl_->frameMessageOf(*impl_->pendingFrame));
+      impl_->messages.publishFrame(
+          impl_->frameMessageOf(*impl_->pendingFrame, impl_->recentTimings.medians()));
       impl_->pendingFrame.reset();
     }
   }

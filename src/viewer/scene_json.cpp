@@ -1,17 +1,37 @@
 #include "scene_json.hpp"
 
+#include <algorithm>
+
 #include "json_out.hpp"
 
 namespace orbis::viewer_detail {
 
-std::string frameMessage(const FrameSnapshot& frame, std::string_view jpegBase64) {
+void RecentTimings::add(double extractionMs, double trackingMs) {
+  extraction_[next_] = extractionMs;
+  tracking_[next_] = trackingMs;
+  next_ = (next_ + 1) % kFrames;
+  count_ = std::min(count_ + 1, kFrames);
+}
+
+FrameTimingMedians RecentTimings::medians() const {
+  auto median = [this](std::array<double, kFrames> values) {
+    if (count_ == 0) return 0.0;
+    auto middle = values.begin() + static_cast<std::ptrdiff_t>(count_ / 2);
+    std::nth_element(values.begin(), middle, values.begin() + static_cast<std::ptrdiff_t>(count_));
+    return *middle;
+  };
+  return {median(extraction_), median(tracking_)};
+}
+
+std::string frameMessage(const FrameSnapshot& frame, std::string_view jpegBase64, const FrameTimingMedians& medians) {
   JsonOut out;
   out.raw("{").key("index").integer(static_cast<long long>(frame.index)).key("t").number(frame.timestamp, 6);
   out.key("state").raw("\"").raw(toString(frame.state)).raw("\"");
   out.key("newKeyFrame").raw(frame.newKeyFrame ? "true" : "false").key("inliers").integer(frame.inliers);
   out.key("width").number(frame.imageWidth, 0).key("height").number(frame.imageHeight, 0);
   out.key("ms").raw("{").key("extraction").number(frame.extractionMs, 2);
-  out.key("tracking").number(frame.trackingMs, 2).raw("}");
+  out.key("tracking").number(frame.trackingMs, 2).key("extractionMedian").number(medians.extraction, 2);
+  out.key("trackingMedian").number(medians.tracking, 2).raw("}");
   out.key("Twc");
   if (frame.state == TrackingState::Ok) out.pose(frame.Tcw.inverse());
   else out.raw("null");

@@ -5,8 +5,15 @@ Drives Chromium over the DevTools protocol through --remote-debugging-pipe (JSON
 NUL-terminated, on file descriptors 3 and 4): the standard library is enough, no WebSocket
 client or npm package. Prints the value of --report (JSON) when the condition held; logs every
 URL the page requested (Network.requestWillBeSent; data: URLs, decoded in place, left out) to
---requests. Exits 1 when the condition
-did not hold within --timeout seconds (the screenshot is still taken, for a look at why).
+--requests. With --then, reports (and takes the screenshot) when --until holds and reports
+again when --then holds. With --ready-file, starts the browser first and loads the page as
+soon as the server answers. With --metrics FILE, writes where the browser spent its CPU (JSON):
+the page's Performance.getMetrics (ScriptDuration, LayoutDuration, RecalcStyleDuration,
+TaskDuration, ...), the CPU seconds of the Chromium processes by --type (browser, renderer,
+gpu-process, utility) and of their busiest threads, from /proc, and with --js-profile the
+JavaScript functions with the most self time (Profiler). SIGTERM ends the wait but still
+reports, writes the metrics and closes the browser. Exits 1 when a condition did not hold
+within --timeout seconds (the screenshot is still taken, for a look at why).
 
   page_probe.py URL --until 'window.orbisScene.loopClosures >= 1' --screenshot shot.png
 """
@@ -23,6 +30,8 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.error
+import urllib.request
 
 
 class Chromium:
@@ -157,6 +166,17 @@ def top_functions(profile, count=15):
     return [(round(us / 1000, 1), name) for name, us in sorted(by_name.items(), key=lambda x: -x[1])[:count]]
 
 
+def wait_for_url(url, deadline):
+    while time.monotonic() < deadline:
+        try:
+            urllib.request.urlopen(url, timeout=1).close()
+            return
+        except urllib.error.HTTPError:  # an answer all the same
+            return
+        except OSError:
+            time.sleep(0.05)
+
+
 class Stopped(Exception):
     """SIGTERM: stop waiting, but still report, write the metrics and close the browser."""
 
@@ -165,14 +185,48 @@ def stop_on_sigterm(signum, frame):
     raise Stopped()
 
 
+def wait_until(evaluate, expression, deadline, poll, settle):
+    """Whether the page's `expression` became true before `deadline`; then `settle` seconds more."""
+    while time.monotonic() < deadline:
+        if evaluate("Boolean(%s)" % expression) is True:
+            time.sleep(settle)
+            return True
+        time.sleep(poll)
+    return False
+
+
+def take_screenshot(browser, session, path):
+    if path:
+        shot = browser.call("Page.captureScreenshot", {"format": "png"}, session=session)
+        with open(path, "wb") as f:
+            f.write(base64.b64decode(shot["data"]))
+
+
+def write_metrics(browser, session, args, cpu_before_page):
+    metrics = browser.call("Performance.getMetrics", session=session)["metrics"]
+    by_kind, by_thread = process_tree_cpu(browser.process.pid)
+    result = {"page": {m["name"]: m["value"] for m in metrics}, "cpu_seconds": by_kind,
+              "cpu_seconds_before_page": cpu_before_page, "cpu_seconds_by_thread": by_thread}
+    if args.js_profile:
+        result["js_self_ms"] = top_functions(browser.call("Profiler.stop", session=session)["profile"])
+    with open(args.metrics, "w") as f:
+        json.dump(result, f, indent=1)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("url")
     parser.add_argument("--until", default="true", help="JavaScript expression to wait for")
+    parser.add_argument("--then", help="with --until: print the report and take the screenshot when --until "
+                        "holds, then wait for this expression too and print the report again")
     parser.add_argument("--report", default="JSON.stringify(window.orbisScene)", help="JavaScript expression to print")
     parser.add_argument("--screenshot", help="PNG file")
     parser.add_argument("--requests", help="file: every URL the page requested, one a line")
     parser.add_argument("--timeout", type=float, default=120)
+    parser.add_argument("--ready-file", help="written once the browser has started; then the page is loaded as soon "
+                        "as URL answers (so a benchmark can start the browser before the server)")
+    parser.add_argument("--eval", help="JavaScript to run once the page has loaded (e.g. to switch a part of it off "
+                        "and see what that part costs)")
     parser.add_argument("--poll", type=float, default=0.2, help="seconds between two checks of --until")
     parser.add_argument("--settle", type=float, default=0.5, help="seconds between the condition and the shot")
     parser.add_argument("--size", default="1400x800")
@@ -188,6 +242,9 @@ def main():
     try:
         target = browser.call("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = browser.call("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+        evaluate = lambda expression: browser.call(
+            "Runtime.evaluate", {"expression": expression, "returnByValue": True}, session=session
+        ).get("result", {}).get("value")
         browser.call("Network.enable", session=session)
         browser.call("Page.enable", session=session)
         if args.metrics:
@@ -195,36 +252,32 @@ def main():
             if args.js_profile:
                 browser.call("Profiler.enable", session=session)
                 browser.call("Profiler.start", session=session)
+        cpu_before_page = {}
+        if args.ready_file:
+            cpu_before_page = process_tree_cpu(browser.process.pid)[0]
+            open(args.ready_file, "w").close()
+            wait_for_url(args.url, time.monotonic() + args.timeout)
         browser.call("Page.navigate", {"url": args.url}, session=session)
         deadline = time.monotonic() + args.timeout
         signal.signal(signal.SIGTERM, stop_on_sigterm)
         try:
-            while time.monotonic() < deadline:
-                result = browser.call("Runtime.evaluate", {"expression": "Boolean(%s)" % args.until,
-                                                           "returnByValue": True}, session=session)
-                if result.get("result", {}).get("value") is True:
-                    held = True
-                    break
-                time.sleep(args.poll)
-            time.sleep(args.settle)
+            if args.eval:
+                while evaluate("document.readyState") != "complete":
+                    time.sleep(0.05)
+                evaluate(args.eval)
+            held = wait_until(evaluate, args.until, deadline, args.poll, args.settle)
+            if args.then:  # the first report and the screenshot now, the last one below
+                print(evaluate(args.report), flush=True)
+                take_screenshot(browser, session, args.screenshot)
+                held = wait_until(evaluate, args.then, deadline, args.poll, args.settle) and held
         except Stopped:
             pass
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        report = browser.call("Runtime.evaluate", {"expression": args.report, "returnByValue": True}, session=session)
-        print(report.get("result", {}).get("value"))
+        print(evaluate(args.report))
         if args.metrics:
-            metrics = browser.call("Performance.getMetrics", session=session)["metrics"]
-            by_kind, by_thread = process_tree_cpu(browser.process.pid)
-            result = {"page": {m["name"]: m["value"] for m in metrics}, "cpu_seconds": by_kind,
-                      "cpu_seconds_by_thread": by_thread}
-            if args.js_profile:
-                result["js_self_ms"] = top_functions(browser.call("Profiler.stop", session=session)["profile"])
-            with open(args.metrics, "w") as f:
-                json.dump(result, f, indent=1)
-        if args.screenshot:
-            shot = browser.call("Page.captureScreenshot", {"format": "png"}, session=session)
-            with open(args.screenshot, "wb") as f:
-                f.write(base64.b64decode(shot["data"]))
+            write_metrics(browser, session, args, cpu_before_page)
+        if not args.then:
+            take_screenshot(browser, session, args.screenshot)
         if args.requests:
             urls = [e["params"]["request"]["url"] for e in browser.events
                     if e.get("method") == "Network.requestWillBeSent"]
@@ -235,7 +288,7 @@ def main():
         browser.close()
         shutil.rmtree(profile, ignore_errors=True)
     if not held:
-        print("page_probe: %r did not hold within %g s" % (args.until, args.timeout), file=sys.stderr)
+        print("page_probe: %r did not hold within %g s" % (args.then or args.until, args.timeout), file=sys.stderr)
         return 1
     return 0
 

@@ -25,7 +25,6 @@ const ui = (id) => document.getElementById(id);
 const store = new SceneStore();
 const view = { paused: false, frame: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
                mode: 'follow', cameraCentre: null, loopsSeen: 0, userMoved: false, recolour: false };
-const timings = { extraction: [], tracking: [] };
 
 // ---- three.js scene ------------------------------------------------------------------------
 function softwareWebGl() {  // SwiftShader and the like: every pixel costs CPU
@@ -254,26 +253,14 @@ function setText(id, text) {  // the DOM is touched only for a change: no style 
   if (element.textContent !== text) element.textContent = text;
 }
 
-function median(values) {
-  const s = [...values].sort((a, b) => a - b);
-  return s.length ? s[Math.floor(s.length / 2)] : 0;
-}
-
-function recordTiming(frame) {  // every frame received counts in the medians, shown or not
-  for (const name of Object.keys(timings)) {
-    timings[name].push(frame.ms[name]);
-    if (timings[name].length > 100) timings[name].shift();
-  }
-}
-
 function showFrame(frame) {
   window.orbisScene.frames = Math.max(window.orbisScene.frames, frame.index + 1);
   setText('state', frame.state);
   const stateClass = 'n state-' + frame.state;
   if (ui('state').className !== stateClass) ui('state').className = stateClass;
   setText('frame', frame.index + (frame.newKeyFrame ? ' (new keyframe)' : ''));
-  for (const name of Object.keys(timings))
-    setText('t-' + name, frame.ms[name].toFixed(1) + ' · ' + median(timings[name]).toFixed(1));
+  for (const name of ['extraction', 'tracking'])  // this frame's, and the median the server keeps
+    setText('t-' + name, frame.ms[name].toFixed(1) + ' · ' + frame.ms[name + 'Median'].toFixed(1));
   drawImage(frame);
 }
 
@@ -475,7 +462,6 @@ function connect() {
   events.onopen = () => store.reset();
   events.addEventListener('frame', (e) => {
     view.frame = JSON.parse(e.data);
-    recordTiming(view.frame);
     streamedUpdate();
   });
   events.addEventListener('map', (e) => {
