@@ -7,6 +7,7 @@
 #   ORBIS     the binary (default build/release/orbis); VIEWER_CLIENT=curl|chromium: what reads
 #             the stream (curl: the event stream only; chromium: the page, rendering headless,
 #             which also puts the browser's own CPU on the machine).
+#   SETTLE    seconds of rest before each run (default 2)
 #   ORBIS_BASELINE  another binary (an older build): each round then runs it with the viewer
 #             too ("base"), between the run without and the run with ORBIS's viewer ("on"), so
 #             the two viewers meet the same machine load.
@@ -26,6 +27,7 @@ orbis=${ORBIS:-$root/build/release/orbis}
 baseline=${ORBIS_BASELINE:-}
 client=${VIEWER_CLIENT:-curl}
 port=${VIEWER_PORT:-18791}
+settle=${SETTLE:-2}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
@@ -42,6 +44,7 @@ PY
 run() {  # run NAME BINARY [orbis args...]: CPU seconds (user + system) into NAME.cpu
   local name=$1 binary=$2
   shift 2
+  sleep "$settle"  # the previous run's browser is still closing: every run starts as calm
   /usr/bin/time -f "%U %S" -o "$work/$name.time" "$binary" run tum "$sequence" \
     --settings "$root/examples/settings/TUM3.yaml" --out "$work/$name" "$@" >"$work/$name.log" 2>&1
   awk '{print $1 + $2}' "$work/$name.time" >"$work/$name.cpu"

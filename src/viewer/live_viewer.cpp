@@ -3,12 +3,12 @@
 #include <httplib.h>
 
 #include <algorithm>
-#include <deque>
 #include <atomic>
-#include <optional>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <time.h>
 #include <unordered_set>
@@ -29,8 +29,8 @@ namespace {
 // What the browsers are sent. Frames: only the newest one, numbered; a browser that lags skips
 // frames. Maps: a browser first gets the whole map (encoder.full()), then the numbered changes
 // (map_delta.hpp) in order; the last kMapDeltasKept of them are kept, and a browser that lags
-// further behind gets the whole map again. Readers (one per browser) wait for what they have not been
-// sent; writers never wait for readers.
+// further behind gets the whole map again. Readers (one per browser) wait for what they have not
+// been sent; writers never wait for readers.
 class Outbox {
  public:
   enum Kind { kFrame, kMap };

@@ -62,6 +62,21 @@ void writeLoopClosures(JsonOut& out, const std::vector<LoopClosureEvent>& closur
   out.raw("]");
 }
 
+// Drops what the snapshot of message `seq` no longer held (points, keyframes: id -> entry with
+// seenIn); returns their ids.
+template <typename SentById>
+std::vector<std::uint64_t> dropUnseen(SentById& sent, std::uint64_t seq) {
+  std::vector<std::uint64_t> dropped;
+  for (auto it = sent.begin(); it != sent.end();)
+    if (it->second.seenIn != seq) {
+      dropped.push_back(it->first);
+      it = sent.erase(it);
+    } else {
+      ++it;
+    }
+  return dropped;
+}
+
 }  // namespace
 
 MapDeltaEncoder::Message MapDeltaEncoder::encode(const MapSnapshot& map, const std::unordered_set<MapPointId>& localMap,
@@ -84,15 +99,7 @@ MapDeltaEncoder::Message MapDeltaEncoder::encode(const MapSnapshot& map, const s
     sent->second.seenIn = seq;
   }
   out.raw("]");
-  std::vector<std::uint64_t> removed;
-  for (auto it = keyFrames_.begin(); it != keyFrames_.end();)
-    if (it->second.seenIn != seq) {
-      removed.push_back(it->first);
-      it = keyFrames_.erase(it);
-    } else {
-      ++it;
-    }
-  writeIds(out, "removedKeyFrames", removed);
+  writeIds(out, "removedKeyFrames", dropUnseen(keyFrames_, seq));
 
   out.key("points").raw("[");
   for (const MapPointSnapshot& p : map.points) {
@@ -108,15 +115,7 @@ MapDeltaEncoder::Message MapDeltaEncoder::encode(const MapSnapshot& map, const s
     s.seenIn = seq;
   }
   out.raw("]");
-  removed.clear();
-  for (auto it = points_.begin(); it != points_.end();)
-    if (it->second.seenIn != seq) {
-      removed.push_back(it->first);
-      it = points_.erase(it);
-    } else {
-      ++it;
-    }
-  writeIds(out, "removedPoints", removed);
+  writeIds(out, "removedPoints", dropUnseen(points_, seq));
 
   // The unchanged beginning keeps the positions sent, so small moves cannot add up unseen.
   std::size_t from = 0;
