@@ -213,7 +213,7 @@ def write_metrics(browser, session, args, cpu_before_page):
         json.dump(result, f, indent=1)
 
 
-def main():
+def parse_arguments():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("url")
     parser.add_argument("--until", default="true", help="JavaScript expression to wait for")
@@ -234,7 +234,11 @@ def main():
     parser.add_argument("--metrics", help="JSON file: the page's Performance metrics and the browser's CPU")
     parser.add_argument("--js-profile", action="store_true", help="with --metrics: sample JavaScript (Profiler)")
     parser.add_argument("--chromium-arg", action="append", default=[], help="one more Chromium flag (repeatable)")
-    args = parser.parse_args()
+    return parser.parse_args()
+
+
+def main():
+    args = parse_arguments()
     width, height = map(int, args.size.split("x"))
     profile = tempfile.mkdtemp(prefix="page_probe_")
     browser = Chromium(args.chromium, width, height, profile, args.chromium_arg)
