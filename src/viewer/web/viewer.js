@@ -1,19 +1,21 @@
 // The orbis live viewer: draws the map and the current frame that LiveViewer streams as
 // server-sent events ("frame" and "map" messages, src/viewer/scene_json.hpp and map_delta.hpp),
-// with three.js; the map is kept by SceneStore (scene_store.js). Coordinates arrive as orbis keeps
+// with three.js; the map is kept by SceneStore (scene_store.js), the panel drawn by panel.js. Coordinates arrive as orbis keeps
 // them (x right, y down, z forward); the world group turns them to three.js's y-up.
 // window.orbisScene holds the counts shown (images: camera images drawn; fullMaps / mapDeltas:
 // map messages of each kind applied), for tests.
 //
 // The browser often runs on the machine that runs SLAM, where every millisecond it spends is
-// taken from tracking: streamed updates are drawn at most STREAM_DRAWS_PER_SECOND times a second
-// (the user's own camera moves at once), geometry is updated in place, materials and shaders are
-// made once, only the frame that is shown has its image decoded, and a software WebGL (no GPU)
-// draws without antialiasing.
+// taken from tracking: streamed updates are drawn at a few hertz (the user's own camera moves at
+// once), geometry is updated in place, materials and shaders are made once, only the frame that
+// is shown has its image decoded, and a software WebGL (no GPU) draws without antialiasing.
 'use strict';
 
-const STREAM_DRAWS_PER_SECOND = 5;
-const STATE_COLOURS = ['#777777', '#4cd964', '#4aa3ff', '#ff4d4d'];  // unmatched, matched, new, outlier
+// Streamed updates of the panel (state, counts, timing, camera image) and of the 3-D view, at most
+// this many a second. Without a GPU every 3-D redraw costs CPU (about 15 ms of Chromium's GPU
+// process with SwiftShader, measured): twice a second then.
+const PANEL_DRAWS_PER_SECOND = 5;
+const SOFTWARE_SCENE_DRAWS_PER_SECOND = 2;
 const LAYERS = {
   points: 'map points', keyFrames: 'keyframes', covisibility: 'covisibility', spanningTree: 'spanning tree',
   loops: 'loop edges', trajectory: 'trajectory', camera: 'current camera',
@@ -21,10 +23,9 @@ const LAYERS = {
 
 window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, live: null, webgl: false,
                       fullMaps: 0, mapDeltas: 0 };
-const ui = (id) => document.getElementById(id);
 const store = new SceneStore();
 const view = { paused: false, frame: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
-               mode: 'follow', cameraCentre: null, loopsSeen: 0, userMoved: false, recolour: false };
+               mode: 'follow', cameraCentre: null, userMoved: false, recolour: false };
 
 // ---- three.js scene ------------------------------------------------------------------------
 function softwareWebGl() {  // SwiftShader and the like: every pixel costs CPU
@@ -41,9 +42,10 @@ function softwareWebGl() {  // SwiftShader and the like: every pixel costs CPU
 }
 
 const canvas = ui('scene');
+const software = softwareWebGl();
 let renderer = null;
 try {
-  renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareWebGl() });
+  renderer = new THREE.WebGLRenderer({ canvas, antialias: !software });
   renderer.setPixelRatio(1);  // CSS pixels: a high-DPI screen would multiply the pixels to fill
   window.orbisScene.webgl = true;
 } catch (e) {
@@ -59,7 +61,7 @@ const camera = new THREE.PerspectiveCamera(55, 1, 0.005, 500);
 camera.position.set(0, 2, -3);
 const controls = renderer ? new THREE.OrbitControls(camera, renderer.domElement) : null;
 if (controls) {
-  controls.addEventListener('change', () => requestDraw());
+  controls.addEventListener('change', () => interactiveDraw());
   controls.addEventListener('start', () => { view.userMoved = true; });  // the user's drag or wheel only
 }
 const layers = {};
@@ -247,92 +249,6 @@ function followCamera() {
   controls.update();
 }
 
-// ---- panel ---------------------------------------------------------------------------------------
-function setText(id, text) {  // the DOM is touched only for a change: no style or layout work else
-  const element = ui(id);
-  if (element.textContent !== text) element.textContent = text;
-}
-
-function showFrame(frame) {
-  window.orbisScene.frames = Math.max(window.orbisScene.frames, frame.index + 1);
-  setText('state', frame.state);
-  const stateClass = 'n state-' + frame.state;
-  if (ui('state').className !== stateClass) ui('state').className = stateClass;
-  setText('frame', frame.index + (frame.newKeyFrame ? ' (new keyframe)' : ''));
-  for (const name of ['extraction', 'tracking'])  // this frame's, and the median the server keeps
-    setText('t-' + name, frame.ms[name].toFixed(1) + ' · ' + frame.ms[name + 'Median'].toFixed(1));
-  drawImage(frame);
-}
-
-// The current image (a scaled-down JPEG; none from a run without images) under the keypoints,
-// drawn at the size the canvas takes on the page. Decoding is asynchronous: a frame whose image
-// arrives after a newer frame's is not drawn.
-const picture = { frame: null };
-function drawImage(frame) {
-  picture.frame = frame;
-  if (!frame.image) {
-    paintImage(frame, null);
-    return;
-  }
-  const img = new Image();
-  img.onload = () => { if (picture.frame === frame) paintImage(frame, img); };
-  img.src = 'data:image/jpeg;base64,' + frame.image;
-}
-
-function paintImage(frame, img) {  // the counts beside the picture are of the frame it shows
-  const counts = [0, 0, 0, 0];
-  for (let i = 2; i < frame.keypoints.length; i += 3) counts[frame.keypoints[i]]++;
-  setText('matches', `${counts[1]} / ${counts[2]} / ${counts[3]}`);
-  const image = ui('image');
-  const width = Math.max(1, Math.round(image.clientWidth || 320));
-  const height = frame.width > 0 ? Math.max(1, Math.round(width * frame.height / frame.width)) : image.height;
-  if (image.width !== width || image.height !== height) {
-    image.width = width;
-    image.height = height;
-  }
-  const g = image.getContext('2d');
-  if (img) {
-    g.drawImage(img, 0, 0, width, height);
-    window.orbisScene.images++;
-  } else {
-    g.fillStyle = '#05070a';
-    g.fillRect(0, 0, width, height);
-  }
-  // As ORB-SLAM2's frame drawer: a box and a centre dot per keypoint; unmatched ones only dimly.
-  const k = frame.keypoints;
-  const s = frame.width > 0 ? width / frame.width : 1;
-  const r = Math.max(2, width / 160);
-  g.lineWidth = 1;
-  for (let state = 0; state < 4; ++state) {  // one colour at a time: fewer state changes
-    g.strokeStyle = g.fillStyle = STATE_COLOURS[state];
-    g.globalAlpha = state === 0 ? 0.45 : 1;
-    for (let i = 0; i < k.length; i += 3) {
-      if (k[i + 2] !== state) continue;
-      const x = k[i] * s, y = k[i + 1] * s;
-      if (state !== 0) g.strokeRect(x - r, y - r, 2 * r, 2 * r);
-      g.fillRect(x - 1, y - 1, 2, 2);
-    }
-  }
-  g.globalAlpha = 1;
-  showSceneState();
-}
-
-function showSceneState() { ui('scene-state').textContent = JSON.stringify(window.orbisScene); }
-
-function announceLoops(closures) {
-  for (let i = view.loopsSeen; i < closures.length; ++i) {
-    const c = closures[i];
-    const item = document.createElement('li');
-    item.textContent = `frame ${c.frame}: keyframe ${c.current} ↔ ${c.loop}, ${c.inliers} inliers`;
-    ui('loops').appendChild(item);
-    const banner = ui('banner');
-    banner.textContent = `loop closed: keyframe ${c.current} ↔ ${c.loop}`;
-    banner.style.display = 'block';
-    setTimeout(() => { banner.style.display = 'none'; }, 4000);
-  }
-  view.loopsSeen = closures.length;
-}
-
 // ---- drawing -----------------------------------------------------------------------------------
 // Brings the scene and the panel up to date with what has arrived, then renders.
 function drawMap() {
@@ -363,37 +279,67 @@ function drawMap() {
   showSceneState();
 }
 
-const drawing = { pending: false, timer: null, last: 0, streamed: false };
+// Interaction (the camera, a layer, the window) draws at the next animation frame; streamed
+// updates wait until their part's period has passed since it was last drawn.
+const drawing = {
+  pending: false, timer: null, interactive: false,
+  panel: { due: false, last: -Infinity, period: 1000 / PANEL_DRAWS_PER_SECOND },
+  view3d: { due: false, last: -Infinity,
+            period: 1000 / (software ? SOFTWARE_SCENE_DRAWS_PER_SECOND : PANEL_DRAWS_PER_SECOND) },
+};
+
 function draw() {
   drawing.pending = false;
-  drawing.last = performance.now();
-  if (!view.paused && drawing.streamed) {
-    drawing.streamed = false;
-    drawMap();
+  const now = performance.now();
+  const { panel, view3d } = drawing;
+  let render = drawing.interactive;
+  drawing.interactive = false;
+  if (!view.paused && panel.due && now - panel.last >= panel.period) {
+    panel.due = false;
+    panel.last = now;
     if (view.frame && view.frame !== view.frameShown) {
       view.frameShown = view.frame;
       showFrame(view.frame);
-      drawCurrentCamera(view.frame);
-      followCamera();
     }
   }
-  if (renderer) renderer.render(scene, camera);
+  if (!view.paused && view3d.due && (render || now - view3d.last >= view3d.period)) {
+    view3d.due = false;
+    view3d.last = now;
+    drawMap();
+    drawCurrentCamera(view.frame);
+    followCamera();
+    render = true;
+  }
+  if (renderer && render) renderer.render(scene, camera);
+  scheduleStreamed();
 }
 
-function requestDraw() {  // at once: the user moved the camera, resized, toggled a layer
+function requestDraw() {
   if (drawing.pending) return;
   drawing.pending = true;
   requestAnimationFrame(draw);
 }
 
-function streamedUpdate() {  // at most STREAM_DRAWS_PER_SECOND times a second
-  drawing.streamed = true;
-  if (drawing.pending || drawing.timer !== null) return;
-  const wait = drawing.last + 1000 / STREAM_DRAWS_PER_SECOND - performance.now();
+function interactiveDraw() {  // at once: the user moved the camera, resized, toggled a layer
+  drawing.interactive = true;
+  requestDraw();
+}
+
+function scheduleStreamed() {
+  if (view.paused || drawing.pending || drawing.timer !== null) return;
+  let at = Infinity;
+  for (const part of [drawing.panel, drawing.view3d]) if (part.due) at = Math.min(at, part.last + part.period);
+  if (at === Infinity) return;
   drawing.timer = setTimeout(() => {
     drawing.timer = null;
     requestDraw();
-  }, Math.max(0, wait));
+  }, Math.max(0, at - performance.now()));
+}
+
+function streamed(panel, view3d) {  // what a message changed
+  drawing.panel.due ||= panel;
+  drawing.view3d.due ||= view3d;
+  scheduleStreamed();
 }
 
 function resize() {
@@ -402,7 +348,7 @@ function resize() {
   renderer.setSize(w, h, false);
   camera.aspect = w / Math.max(1, h);
   camera.updateProjectionMatrix();
-  requestDraw();
+  interactiveDraw();
 }
 
 // ---- controls and stream ---------------------------------------------------------------------------
@@ -412,7 +358,7 @@ function buildControls() {
     box.innerHTML = `<input type="checkbox" checked> ${label}`;
     box.firstChild.addEventListener('change', (e) => {
       layers[name].visible = e.target.checked;
-      requestDraw();
+      interactiveDraw();
     });
     ui('layers').appendChild(box);
   }
@@ -420,21 +366,22 @@ function buildControls() {
     view.mode = e.target.value;
     view.userMoved = false;
     if (controls) fitView(view.mode === 'top');
-    requestDraw();
+    interactiveDraw();
   });
   ui('point-size').addEventListener('input', (e) => {
     pointMaterial.size = Number(e.target.value);
-    requestDraw();
+    interactiveDraw();
   });
   ui('colouring').addEventListener('change', (e) => {
     view.colouring = e.target.value;
     view.recolour = true;
-    streamedUpdate();
+    drawing.view3d.due = true;
+    interactiveDraw();
   });
   ui('pause').addEventListener('click', () => {  // the stream goes on into the store, unseen
     view.paused = !view.paused;
     ui('pause').textContent = view.paused ? 'resume' : 'pause';
-    if (!view.paused) streamedUpdate();
+    if (!view.paused) scheduleStreamed();
   });
   if (window.ResizeObserver) new ResizeObserver(resize).observe(canvas);
   else window.addEventListener('resize', resize);
@@ -462,7 +409,7 @@ function connect() {
   events.onopen = () => store.reset();
   events.addEventListener('frame', (e) => {
     view.frame = JSON.parse(e.data);
-    streamedUpdate();
+    streamed(true, true);  // the panel, and the current camera in 3-D
   });
   events.addEventListener('map', (e) => {
     const message = JSON.parse(e.data);
@@ -472,7 +419,7 @@ function connect() {
       return;
     }
     window.orbisScene[message.full ? 'fullMaps' : 'mapDeltas']++;
-    streamedUpdate();
+    streamed(false, true);
     if (!store.live || ++maps >= closeAfterMaps || store.loopClosures.length >= closeAfterLoops) events.close();
   });
   events.onerror = () => setText('mode', '— disconnected (retrying)');
@@ -482,4 +429,4 @@ buildControls();
 applyQuery();
 resize();
 connect();
-requestDraw();
+interactiveDraw();
