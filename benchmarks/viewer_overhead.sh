@@ -15,10 +15,10 @@
 # tracking stages ("tracking: total") and of the observer's per-frame copy ("tracking: observer",
 # only with the viewer), their sum; the CPU seconds of the whole orbis process; with Chromium,
 # the CPU seconds of all its processes from loading the page to the end of the run
-# (page_probe.py --metrics). On a shared,
-# loaded machine single runs move by tens of percent: the summary compares the best run of each
-# kind (the least disturbed), the medians of the runs, and the median CPU seconds; each run with
-# the viewer also prints what the viewer's publisher thread did.
+# (page_probe.py --metrics). On a shared, loaded machine single runs move by tens of percent: the
+# summary compares the best run of each kind (the least disturbed), the medians of the runs, the
+# median of each round's ratio (with / without the viewer, in the same round), and the median CPU
+# seconds; each run with the viewer also prints what the viewer's publisher thread did.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 sequence=${1:-$root/../shared/datasets/tum_fr3_teddy_200}
@@ -116,6 +116,9 @@ for k in kinds[1:]:
         a, b = f(ms["off"]), f(ms[k])
         print("%s tracking time per frame: %.2f ms without, %.2f ms with %s (%+.1f%%)"
               % (what, a, b, label[k], 100 * (b - a) / a))
+    # Each run against the run without a viewer in its own round: the load of the moment cancels.
+    ratio = statistics.median(b / a for a, b in zip(ms["off"], ms[k]))
+    print("median over the rounds of tracking time per frame with %s / without: %+.1f%%" % (label[k], 100 * (ratio - 1)))
     a, b = statistics.median(cpu["off"]), statistics.median(cpu[k])
     print("median CPU of the orbis run: %.2f s without, %.2f s with %s (%+.1f%%)" % (a, b, label[k], 100 * (b - a) / a))
     browser = [float(r[2]) for r in runs[k] if r[2] != "-"]
