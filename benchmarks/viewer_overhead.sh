@@ -1,25 +1,33 @@
 #!/usr/bin/env bash
 # Tracking time per frame with and without a connected live viewer, back to back.
 #
-# Usage: benchmarks/viewer_overhead.sh [SEQUENCE] [PAIRS]
+# Usage: benchmarks/viewer_overhead.sh [SEQUENCE] [ROUNDS]
 #   SEQUENCE  a TUM RGB-D folder (default ../shared/datasets/tum_fr3_teddy_200, TUM3 settings)
-#   PAIRS     how many (without, with) pairs to run, alternating (default 3)
+#   ROUNDS    how many rounds of (without, with) runs, alternating (default 3)
 #   ORBIS     the binary (default build/release/orbis); VIEWER_CLIENT=curl|chromium: what reads
 #             the stream (curl: the event stream only; chromium: the page, rendering headless,
 #             which also puts the browser's own CPU on the machine).
+#   SETTLE    seconds of rest before each run (default 2)
+#   ORBIS_BASELINE  another binary (an older build): each round then runs it with the viewer
+#             too ("base"), between the run without and the run with ORBIS's viewer ("on"), so
+#             the two viewers meet the same machine load.
 # Runs threaded (as in real time). Per run, from report.json: medians of ORB extraction, of the
 # tracking stages ("tracking: total") and of the observer's per-frame copy ("tracking: observer",
-# only with the viewer), their sum; and the CPU seconds of the whole orbis process. On a shared,
-# loaded machine single runs move by tens of percent: the summary compares the best run of each
-# kind (the least disturbed), the medians of the runs, and the median CPU seconds; each run with
-# the viewer also prints what the viewer's publisher thread did.
+# only with the viewer), their sum; the CPU seconds of the whole orbis process; with Chromium,
+# the CPU seconds of all its processes from loading the page to the end of the run
+# (page_probe.py --metrics). On a shared, loaded machine single runs move by tens of percent: the
+# summary compares the best run of each kind (the least disturbed), the medians of the runs, the
+# median of each round's ratio (with / without the viewer, in the same round), and the median CPU
+# seconds; each run with the viewer also prints what the viewer's publisher thread did.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 sequence=${1:-$root/../shared/datasets/tum_fr3_teddy_200}
-pairs=${2:-3}
+rounds=${2:-3}
 orbis=${ORBIS:-$root/build/release/orbis}
+baseline=${ORBIS_BASELINE:-}
 client=${VIEWER_CLIENT:-curl}
 port=${VIEWER_PORT:-18791}
+settle=${SETTLE:-2}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
@@ -33,57 +41,89 @@ print("%.3f %.3f %.3f %.3f" % (e, k, o, e + k + o))
 PY
 }
 
-run() {  # run NAME [orbis args...]: CPU seconds (user + system) into NAME.cpu
-  local name=$1
-  shift
-  /usr/bin/time -f "%U %S" -o "$work/$name.time" "$orbis" run tum "$sequence" \
+run() {  # run NAME BINARY [orbis args...]: CPU seconds (user + system) into NAME.cpu
+  local name=$1 binary=$2
+  shift 2
+  sleep "$settle"  # the previous run's browser is still closing: every run starts as calm
+  /usr/bin/time -f "%U %S" -o "$work/$name.time" "$binary" run tum "$sequence" \
     --settings "$root/examples/settings/TUM3.yaml" --out "$work/$name" "$@" >"$work/$name.log" 2>&1
   awk '{print $1 + $2}' "$work/$name.time" >"$work/$name.cpu"
 }
 
-with_viewer() {
-  run on --viewer "$port" &
-  local pid=$! reader=""
-  for _ in $(seq 50); do curl -s -m 1 -o /dev/null "http://127.0.0.1:$port/" && break; sleep 0.1; done
+with_viewer() {  # with_viewer NAME BINARY: the browser's CPU seconds into NAME.browser
+  local name=$1 binary=$2
+  rm -f "$work/$name.metrics" "$work/ready"
+  local pid reader
   if [[ $client == chromium ]]; then
-    # Stays on the page, rendering, until it shows the finished run (--dump-dom would leave after
-    # the first messages).
+    # The browser is started first, as a person opens it before the run: its own start-up is not
+    # the viewer's cost (it is left out of its CPU seconds too). It loads the page as soon as
+    # orbis serves it and stays on it, rendering, until orbis has finished; SIGTERM then makes
+    # it write what its processes used and close (--dump-dom would leave after the first
+    # messages). It checks the page once a second, to add little of its own.
     python3 "$root/tests/viewer/page_probe.py" "http://127.0.0.1:$port/" --until "window.orbisScene.live === false" \
-      --timeout 300 >/dev/null 2>&1 &
+      --timeout 300 --poll 1 --ready-file "$work/ready" --metrics "$work/$name.metrics" >/dev/null 2>&1 &
+    reader=$!
+    for _ in $(seq 300); do [[ -e $work/ready ]] && break; sleep 0.1; done
+    run "$name" "$binary" --viewer "$port" &
+    pid=$!
   else
+    run "$name" "$binary" --viewer "$port" &
+    pid=$!
+    for _ in $(seq 50); do curl -s -m 1 -o /dev/null "http://127.0.0.1:$port/" && break; sleep 0.1; done
     curl -s -N -m 300 "http://127.0.0.1:$port/events" >"$work/events.txt" &
+    reader=$!
   fi
-  reader=$!
   wait "$pid"
   kill "$reader" 2>/dev/null || true
   wait "$reader" 2>/dev/null || true
+  if [[ -s $work/$name.metrics ]]; then
+    python3 -c "import json,sys; m=json.load(open(sys.argv[1]))
+print('%.2f' % (sum(m['cpu_seconds'].values()) - sum(m['cpu_seconds_before_page'].values())))" \
+      "$work/$name.metrics" >"$work/$name.browser"
+  else
+    echo "-" >"$work/$name.browser"
+  fi
 }
 
-printf "%-6s %11s %9s %9s %9s %8s\n" run extraction tracking observer "sum ms" "CPU s"
-: >"$work/off.sums"
-: >"$work/on.sums"
-for pair in $(seq "$pairs"); do
-  for kind in off on; do
-    if [[ $kind == off ]]; then run off; else with_viewer; fi
+kinds=(off on)
+[[ -z $baseline ]] || kinds=(off base on)
+printf "%-7s %11s %9s %9s %9s %8s %10s\n" run extraction tracking observer "sum ms" "CPU s" "browser s"
+for kind in "${kinds[@]}"; do : >"$work/$kind.sums"; done
+for round in $(seq "$rounds"); do
+  for kind in "${kinds[@]}"; do
+    case $kind in
+      off) run off "$orbis"; echo "-" >"$work/off.browser" ;;
+      base) with_viewer base "$baseline" ;;
+      on) with_viewer on "$orbis" ;;
+    esac
     read -r e k o sum < <(per_frame_ms "$work/$kind/report.json")
-    echo "$sum $(cat "$work/$kind.cpu")" >>"$work/$kind.sums"
-    printf "%-6s %11s %9s %9s %9s %8s\n" "$kind $pair" "$e" "$k" "$o" "$sum" "$(cat "$work/$kind.cpu")"
+    echo "$sum $(cat "$work/$kind.cpu") $(cat "$work/$kind.browser")" >>"$work/$kind.sums"
+    printf "%-7s %11s %9s %9s %9s %8s %10s\n" "$kind $round" "$e" "$k" "$o" "$sum" "$(cat "$work/$kind.cpu")" \
+      "$(cat "$work/$kind.browser")"
     # What the viewer's own thread did (messages, bytes, its CPU): the cost that is not on tracking's.
-    [[ $kind == off ]] || grep -h "^viewer: [0-9]" "$work/on.log" | sed 's/^/         /' || true
+    [[ $kind == off ]] || grep -h "^viewer: [0-9]" "$work/$kind.log" | sed 's/^/          /' || true
   done
 done
-python3 - "$work/off.sums" "$work/on.sums" <<'PY'
+python3 - "$work" "${kinds[@]}" <<'PY'
 import statistics, sys
-off = [tuple(map(float, l.split())) for l in open(sys.argv[1])]
-on = [tuple(map(float, l.split())) for l in open(sys.argv[2])]
-best_off, best_on = min(s for s, _ in off), min(s for s, _ in on)
-cpu_off, cpu_on = statistics.median(c for _, c in off), statistics.median(c for _, c in on)
-print("best tracking time per frame: %.2f ms without, %.2f ms with the viewer (%+.1f%%)"
-      % (best_off, best_on, 100 * (best_on - best_off) / best_off))
-med_off, med_on = statistics.median(s for s, _ in off), statistics.median(s for s, _ in on)
-print("median tracking time per frame: %.2f ms without, %.2f ms with the viewer (%+.1f%%)"
-      % (med_off, med_on, 100 * (med_on - med_off) / med_off))
-print("median CPU of the run: %.2f s without, %.2f s with the viewer (%+.1f%%)"
-      % (cpu_off, cpu_on, 100 * (cpu_on - cpu_off) / cpu_off))
+work, kinds = sys.argv[1], sys.argv[2:]
+runs = {k: [l.split() for l in open("%s/%s.sums" % (work, k))] for k in kinds}
+ms = {k: [float(r[0]) for r in runs[k]] for k in kinds}
+cpu = {k: [float(r[1]) for r in runs[k]] for k in kinds}
+label = {"base": "the baseline's viewer", "on": "the viewer"}
+for k in kinds[1:]:
+    for what, f in (("best", min), ("median", statistics.median)):
+        a, b = f(ms["off"]), f(ms[k])
+        print("%s tracking time per frame: %.2f ms without, %.2f ms with %s (%+.1f%%)"
+              % (what, a, b, label[k], 100 * (b - a) / a))
+    # Each run against the run without a viewer in its own round: the load of the moment cancels.
+    ratio = statistics.median(b / a for a, b in zip(ms["off"], ms[k]))
+    print("median over the rounds of tracking time per frame with %s / without: %+.1f%%" % (label[k], 100 * (ratio - 1)))
+    a, b = statistics.median(cpu["off"]), statistics.median(cpu[k])
+    print("median CPU of the orbis run: %.2f s without, %.2f s with %s (%+.1f%%)" % (a, b, label[k], 100 * (b - a) / a))
+    browser = [float(r[2]) for r in runs[k] if r[2] != "-"]
+    if browser:
+        print("median CPU of the browser during a run with %s: %.2f s (all its processes, page load on)"
+              % (label[k], statistics.median(browser)))
 PY
 [[ $client == chromium ]] || echo "(viewer client: curl; $(grep -c '^event:' "$work/events.txt" 2>/dev/null || echo 0) events in the last run)"

@@ -105,7 +105,7 @@ int runCommand(const std::vector<std::string>& rawArgs) {
 #ifdef ORBIS_HAS_VIEWER
   std::unique_ptr<LiveViewer> viewer;
   if (p.has("--viewer")) {
-    viewer = std::make_unique<LiveViewer>(ViewerOptions{"127.0.0.1", viewerPort(p), 15, 5});
+    viewer = std::make_unique<LiveViewer>(ViewerOptions{.port = viewerPort(p)});
     std::fprintf(stderr, "viewer: %s\n", viewer->url().c_str());
     options.observer = viewer.get();
   }

@@ -64,7 +64,7 @@ int viewCommand(const std::vector<std::string>& args) {
   if (port < 1 || port > 65535) throw Error("argument --port", "", "expects a port between 1 and 65535");
   MapSnapshot snapshot = fs::is_directory(source) ? snapshotOfRunOutput(source) : snapshotOfMapFile(source);
   std::printf("%zu keyframes, %zu points\n", snapshot.keyFrames.size(), snapshot.points.size());
-  LiveViewer viewer(ViewerOptions{"127.0.0.1", static_cast<int>(port), 15, 5});
+  LiveViewer viewer(ViewerOptions{.port = static_cast<int>(port)});
   viewer.show(std::move(snapshot));
   std::printf("viewer: %s (Ctrl-C to stop)\n", viewer.url().c_str());
   std::fflush(stdout);

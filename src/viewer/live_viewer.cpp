@@ -2,18 +2,20 @@
 
 #include <httplib.h>
 
-#include <array>
+#include <algorithm>
 #include <atomic>
-#include <optional>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <time.h>
 #include <unordered_set>
 
 #include "orbis/util/error.hpp"
 #include "frame_image.hpp"
+#include "map_delta.hpp"
 #include "scene_json.hpp"
 #include "web_assets.hpp"
 
@@ -24,44 +26,71 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-// The newest message of each kind, numbered. Readers (one per browser) wait for a number they
-// have not sent yet; writers never wait for readers.
-class LatestMessages {
+// What the browsers are sent. Frames: only the newest one, numbered; a browser that lags skips
+// frames. Maps: a browser first gets the whole map (encoder.full()), then the numbered changes
+// (map_delta.hpp) in order; the last kMapDeltasKept of them are kept, and a browser that lags
+// further behind gets the whole map again. Readers (one per browser) wait for what they have not
+// been sent; writers never wait for readers.
+class Outbox {
  public:
-  enum Kind { kFrame, kMap, kKinds };
+  enum Kind { kFrame, kMap };
+  static constexpr std::size_t kMapDeltasKept = 32;  // 6 s at 5 map messages a second
+  struct Seen {
+    std::uint64_t frame = 0, map = 0;  // map: the last map message applied (0: an empty scene)
+  };
 
-  void publish(Kind kind, std::string message) {
+  explicit Outbox(const MapDeltaEncoder& encoder) : encoder_(encoder) {}
+
+  void publishFrame(std::string message) {
     auto shared = std::make_shared<const std::string>(std::move(message));
     {
       std::lock_guard lock(mutex_);
-      latest_[kind] = std::move(shared);
-      serial_[kind] = ++counter_;
-      taken_[kind] = false;
+      frame_ = std::move(shared);
+      ++frameSerial_;
+      frameTaken_ = false;
     }
     changed_.notify_all();
   }
-  // Whether a browser has been handed the newest message of this kind (true before the first):
-  // while it has not, building a newer one would only be thrown away.
-  bool taken(Kind kind) const {
-    std::lock_guard lock(mutex_);
-    return taken_[kind];
+  void publishMap(MapDeltaEncoder::Message delta) {
+    auto shared = std::make_shared<const std::string>(std::move(delta.json));
+    {
+      std::lock_guard lock(mutex_);
+      mapDeltas_.emplace_back(delta.seq, std::move(shared));
+      if (mapDeltas_.size() > kMapDeltasKept) mapDeltas_.pop_front();
+      newestMap_ = std::max(newestMap_, delta.seq);
+    }
+    changed_.notify_all();
   }
-  // Waits up to `timeout` for a message newer than seen[kind]; returns it (or null) and updates seen.
-  using Seen = std::array<std::uint64_t, kKinds>;
+  // Whether a browser has been handed the newest frame (true before the first): while it has
+  // not, building a newer one would only be thrown away.
+  bool frameTaken() const {
+    std::lock_guard lock(mutex_);
+    return frameTaken_;
+  }
+  // Waits up to `timeout` for a frame or map message this browser has not been sent; returns it
+  // (or null) and updates `seen`.
   std::shared_ptr<const std::string> next(Seen& seen, Kind& kind, std::chrono::milliseconds timeout) {
     std::unique_lock lock(mutex_);
-    auto fresh = [&] {
-      for (int k = 0; k < kKinds; ++k)
-        if (serial_[k] > seen[k]) return k;
-      return -1;
-    };
-    changed_.wait_for(lock, timeout, [&] { return fresh() >= 0 || closed_; });
-    const int k = fresh();
-    if (k < 0) return nullptr;
-    seen[k] = serial_[k];
-    taken_[k] = true;
-    kind = static_cast<Kind>(k);
-    return latest_[k];
+    changed_.wait_for(lock, timeout,
+                      [&] { return frameSerial_ > seen.frame || newestMap_ > seen.map || closed_; });
+    if (frameSerial_ > seen.frame) {
+      seen.frame = frameSerial_;
+      frameTaken_ = true;
+      kind = kFrame;
+      return frame_;
+    }
+    if (newestMap_ <= seen.map) return nullptr;
+    kind = kMap;
+    if (seen.map > 0)  // a page that has a map: the next change, while it is kept
+      for (const auto& [seq, message] : mapDeltas_)
+        if (seq == seen.map + 1) {
+          seen.map = seq;
+          return message;
+        }
+    lock.unlock();  // the encoder has its own lock; building the whole map takes a while
+    MapDeltaEncoder::Message whole = encoder_.full();
+    seen.map = whole.seq;
+    return std::make_shared<const std::string>(std::move(whole.json));
   }
   void close() {
     {
@@ -76,12 +105,14 @@ class LatestMessages {
   }
 
  private:
+  const MapDeltaEncoder& encoder_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::shared_ptr<const std::string> latest_[kKinds];
-  std::uint64_t serial_[kKinds] = {};
-  bool taken_[kKinds] = {true, true};
-  std::uint64_t counter_ = 0;
+  std::shared_ptr<const std::string> frame_;
+  std::uint64_t frameSerial_ = 0;
+  bool frameTaken_ = true;
+  std::deque<std::pair<std::uint64_t, std::shared_ptr<const std::string>>> mapDeltas_;
+  std::uint64_t newestMap_ = 0;
   bool closed_ = false;
 };
 
@@ -91,12 +122,14 @@ struct LiveViewer::Impl {
   ViewerOptions options;
   httplib::Server server;
   std::thread serverThread, publisherThread;
-  LatestMessages messages;
+  MapDeltaEncoder mapEncoder;
+  Outbox messages{mapEncoder};
   std::atomic<int> clients{0};
 
   std::mutex mutex;  // guards the fields below
   std::condition_variable wake;
   std::optional<FrameSnapshot> pendingFrame;
+  RecentTimings recentTimings;       // of every frame, for the medians the page shows
   std::vector<MapPointId> localMap;  // of the newest frame
   bool stopping = false;
   std::mutex sourceMutex;  // held while a snapshot is taken: detach() waits for it, onFrame() never
@@ -110,14 +143,14 @@ struct LiveViewer::Impl {
   void streamEvents(httplib::Response& response);
   void publishLoop();
   void publishMap(const MapSnapshot& map, bool live);
-  std::string frameMessageOf(FrameSnapshot& frame) const;
+  std::string frameMessageOf(FrameSnapshot& frame, const FrameTimingMedians& medians) const;
 };
 
 // The frame's message with its image; the image reference is let go here, on this thread.
-std::string LiveViewer::Impl::frameMessageOf(FrameSnapshot& frame) const {
+std::string LiveViewer::Impl::frameMessageOf(FrameSnapshot& frame, const FrameTimingMedians& medians) const {
   const std::string jpeg = jpegBase64(frame.image, options.imageMaxWidth, options.jpegQuality);
   frame.image.release();
-  return frameMessage(frame, jpeg);
+  return frameMessage(frame, jpeg, medians);
 }
 
 void LiveViewer::Impl::serveRoutes() {
@@ -144,14 +177,14 @@ void LiveViewer::Impl::streamEvents(httplib::Response& response) {
   response.set_header("Cache-Control", "no-cache");
   ++clients;
   wake.notify_all();  // a new browser wants the current map now
-  auto seen = std::make_shared<LatestMessages::Seen>();
+  auto seen = std::make_shared<Outbox::Seen>();  // a new page starts from an empty scene
   response.set_chunked_content_provider(
       "text/event-stream",
       [this, seen](std::size_t, httplib::DataSink& sink) {
-        LatestMessages::Kind kind{};
+        Outbox::Kind kind{};
         auto message = messages.next(*seen, kind, std::chrono::milliseconds(500));
         if (messages.closed()) return false;
-        std::string event = message ? std::string("event: ") + (kind == LatestMessages::kFrame ? "frame" : "map") +
+        std::string event = message ? std::string("event: ") + (kind == Outbox::kFrame ? "frame" : "map") +
                                           "\ndata: " + *message + "\n\n"
                                     : std::string(": keep-alive\n\n");
         return sink.write(event.data(), event.size());
@@ -177,9 +210,9 @@ void LiveViewer::Impl::publishMap(const MapSnapshot& map, bool live) {
     std::lock_guard lock(mutex);
     local.insert(localMap.begin(), localMap.end());
   }
-  std::string message = mapMessage(map, local, live);
-  countMessage(true, message.size());
-  messages.publish(LatestMessages::kMap, std::move(message));
+  MapDeltaEncoder::Message delta = mapEncoder.encode(map, local, live);
+  countMessage(true, delta.json.size());
+  messages.publishMap(std::move(delta));
 }
 
 void LiveViewer::Impl::publishLoop() {
@@ -195,14 +228,15 @@ void LiveViewer::Impl::publishLoop() {
     if (clients == 0) continue;  // nobody watching: no work at all
     // A browser that has not yet been sent the last frame is slow: its frames wait (and are
     // replaced by newer ones) instead of being encoded for nothing.
-    if (pendingFrame && now - lastFrame >= framePeriod && messages.taken(LatestMessages::kFrame)) {
+    if (pendingFrame && now - lastFrame >= framePeriod && messages.frameTaken()) {
       FrameSnapshot frame = std::move(*pendingFrame);
       pendingFrame.reset();
       localMap = std::move(frame.localMapPoints);
+      const FrameTimingMedians medians = recentTimings.medians();
       lock.unlock();
-      std::string message = frameMessageOf(frame);
+      std::string message = frameMessageOf(frame, medians);
       countMessage(false, message.size());
-      messages.publish(LatestMessages::kFrame, std::move(message));
+      messages.publishFrame(std::move(message));
       lock.lock();
       lastFrame = now;
     }
@@ -267,6 +301,7 @@ void LiveViewer::onFrame(FrameSnapshot&& frame) {
   {
     std::lock_guard lock(impl_->mutex);
     dropped.swap(impl_->pendingFrame);
+    impl_->recentTimings.add(frame.extractionMs, frame.trackingMs);
     impl_->pendingFrame.emplace(std::move(frame));
   }
 }
@@ -280,7 +315,8 @@ void LiveViewer::detach(MapSnapshot finalMap) {
     std::lock_guard lock(impl_->mutex);
     if (impl_->pendingFrame) {
       impl_->localMap = std::move(impl_->pendingFrame->localMapPoints);
-      impl_->messages.publish(LatestMessages::kFrame, impl_->frameMessageOf(*impl_->pendingFrame));
+      impl_->messages.publishFrame(
+          impl_->frameMessageOf(*impl_->pendingFrame, impl_->recentTimings.medians()));
       impl_->pendingFrame.reset();
     }
   }

@@ -80,7 +80,7 @@ print("page requests: " + " ".join(page))
 foreign = [u for u in page if not local.match(u)]
 assert not foreign, "the page requested off the machine: %s" % foreign
 paths = {local.sub("/", u) for u in page}
-for needed in ("/", "/three.min.js", "/OrbitControls.js", "/viewer.js", "/events"):
+for needed in ("/", "/three.min.js", "/OrbitControls.js", "/scene_store.js", "/panel.js", "/viewer.js", "/events"):
     assert needed in paths, "no request for %s" % needed
 # The net log is JSON that a killed browser may leave unterminated: read its URLs textually.
 logged = set(re.findall(r'"url":"([^"]+)"', open(sys.argv[3], errors="replace").read()))

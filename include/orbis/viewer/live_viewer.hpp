@@ -7,7 +7,9 @@
 // frame into a message at most frameRateHz times a second (with its image scaled down and JPEG-
 // encoded there, never on the tracking thread; the frames in between are dropped, and no new
 // frame is encoded while no browser has been sent the previous one) and takes a map snapshot at
-// mapRateHz, and only while a browser is connected. Each browser gets the newest message of each kind: a
+// mapRateHz, and only while a browser is connected. A browser is sent the whole map when it
+// connects, then what changed since the previous map message (src/viewer/map_delta.hpp); one that
+// lags further behind than the recent changes kept is sent the whole map again. Each browser gets the newest frame: a
 // slow or vanished browser misses updates, never delays tracking. detach() or show() publish a
 // final map, which the page keeps showing until the viewer is destroyed. The constructor throws
 // orbis::Error when the port cannot be bound; the destructor stops the server and threads.
@@ -23,7 +25,9 @@ namespace orbis {
 struct ViewerOptions {
   std::string host = "127.0.0.1";
   int port = 8080;
-  double frameRateHz = 15;  // frame messages (keypoints, pose, timing) per second, at most
+  // Frame messages (keypoints, pose, timing, image) per second, at most: the page draws streamed
+  // updates 5 times a second (a browser on the SLAM machine takes its CPU from tracking).
+  double frameRateHz = 5;
   double mapRateHz = 5;     // map snapshots per second, at most
   int imageMaxWidth = 320;  // the camera image, scaled down to this width as JPEG; 0: no image
   int jpegQuality = 70;

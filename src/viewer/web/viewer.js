@@ -1,28 +1,52 @@
 // The orbis live viewer: draws the map and the current frame that LiveViewer streams as
-// server-sent events ("frame" and "map" messages, src/viewer/scene_json.hpp), with three.js.
-// Coordinates arrive as orbis keeps them (x right, y down, z forward); the world group turns
-// them to three.js's y-up. window.orbisScene holds the counts shown (images: camera images
-// drawn), for tests.
+// server-sent events ("frame" and "map" messages, src/viewer/scene_json.hpp and map_delta.hpp),
+// with three.js; the map is kept by SceneStore (scene_store.js), the panel drawn by panel.js. Coordinates arrive as orbis keeps
+// them (x right, y down, z forward); the world group turns them to three.js's y-up.
+// window.orbisScene holds the counts shown (images: camera images drawn; fullMaps / mapDeltas:
+// map messages of each kind applied), for tests.
+//
+// The browser often runs on the machine that runs SLAM, where every millisecond it spends is
+// taken from tracking: streamed updates are drawn at a few hertz (the user's own camera moves at
+// once), geometry is updated in place, materials and shaders are made once, only the frame that
+// is shown has its image decoded, and a software WebGL (no GPU) draws without antialiasing.
 'use strict';
 
-const STATE_COLOURS = ['#777777', '#4cd964', '#4aa3ff', '#ff4d4d'];  // unmatched, matched, new, outlier
+// Streamed updates of the panel (state, counts, timing, camera image) and of the 3-D view, at most
+// this many a second. Without a GPU every 3-D redraw costs CPU (about 15 ms of Chromium's GPU
+// process with SwiftShader, measured): twice a second then.
+const PANEL_DRAWS_PER_SECOND = 5;
+const SOFTWARE_SCENE_DRAWS_PER_SECOND = 2;
 const LAYERS = {
   points: 'map points', keyFrames: 'keyframes', covisibility: 'covisibility', spanningTree: 'spanning tree',
   loops: 'loop edges', trajectory: 'trajectory', camera: 'current camera',
 };
 
-window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, live: null, webgl: false };
-const ui = (id) => document.getElementById(id);
-const view = { paused: false, latestFrame: null, latestMap: null, fitted: false, frustumSize: 0.05,
-               pointSize: 2, colouring: 'local', mode: 'follow', cameraCentre: null, loopsSeen: 0,
-               userMoved: false };
-const timings = { extraction: [], tracking: [] };
+window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, live: null, webgl: false,
+                      fullMaps: 0, mapDeltas: 0 };
+const store = new SceneStore();
+const view = { paused: false, frame: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
+               mode: 'follow', cameraCentre: null, userMoved: false, recolour: false };
 
 // ---- three.js scene ------------------------------------------------------------------------
+function softwareWebGl() {  // SwiftShader and the like: every pixel costs CPU
+  try {
+    const gl = document.createElement('canvas').getContext('webgl');
+    const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+    const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+    const lose = gl && gl.getExtension('WEBGL_lose_context');
+    if (lose) lose.loseContext();
+    return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+  } catch (e) {
+    return false;
+  }
+}
+
 const canvas = ui('scene');
+const software = softwareWebGl();
 let renderer = null;
 try {
-  renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  renderer = new THREE.WebGLRenderer({ canvas, antialias: !software });
+  renderer.setPixelRatio(1);  // CSS pixels: a high-DPI screen would multiply the pixels to fill
   window.orbisScene.webgl = true;
 } catch (e) {
   ui('legend').textContent = 'WebGL is not available: ' + e.message;
@@ -32,11 +56,12 @@ scene.background = new THREE.Color(0x0e1117);
 const world = new THREE.Group();
 world.rotation.x = Math.PI;  // orbis y down, z forward -> three.js y up
 scene.add(world);
+world.updateMatrixWorld();
 const camera = new THREE.PerspectiveCamera(55, 1, 0.005, 500);
 camera.position.set(0, 2, -3);
 const controls = renderer ? new THREE.OrbitControls(camera, renderer.domElement) : null;
 if (controls) {
-  controls.addEventListener('change', () => requestRender());
+  controls.addEventListener('change', () => interactiveDraw());
   controls.addEventListener('start', () => { view.userMoved = true; });  // the user's drag or wheel only
 }
 const layers = {};
@@ -45,22 +70,51 @@ for (const name of Object.keys(LAYERS)) {
   world.add(layers[name]);
 }
 
-function replaceLayer(name, object) {
-  const group = layers[name];
-  for (const child of group.children) {
-    child.geometry.dispose();
-    child.material.dispose();
+// A layer's lines, in one geometry refilled in place (grown when too small) with one material.
+class Lines {
+  constructor(layer, colour, opacity = 1, strip = false) {
+    this.material = new THREE.LineBasicMaterial({ color: colour, transparent: opacity < 1, opacity });
+    this.layer = layer;
+    this.strip = strip;
+    this.data = new Float32Array(0);
+    this.n = 0;
+    this.object = null;
   }
-  group.remove(...group.children);
-  if (object) group.add(object);
+  begin() { this.n = 0; }
+  vertex(x, y, z) {
+    if (this.n + 3 > this.data.length) {
+      const grown = new Float32Array(Math.max(3072, 2 * this.data.length));
+      grown.set(this.data);
+      this.data = grown;
+    }
+    this.data[this.n++] = x;
+    this.data[this.n++] = y;
+    this.data[this.n++] = z;
+  }
+  end() {
+    if (!this.object || this.object.geometry.attributes.position.array !== this.data) {
+      if (this.object) {
+        this.object.geometry.dispose();
+        this.layer.remove(this.object);
+      }
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute('position', new THREE.BufferAttribute(this.data, 3).setUsage(THREE.DynamicDrawUsage));
+      this.object = this.strip ? new THREE.Line(geometry, this.material) : new THREE.LineSegments(geometry, this.material);
+      this.object.frustumCulled = false;  // its bounds change with every update
+      this.layer.add(this.object);
+    }
+    this.object.geometry.attributes.position.needsUpdate = true;
+    this.object.geometry.setDrawRange(0, this.n / 3);
+  }
 }
 
-function lineSegments(positions, colour, opacity = 1) {
-  const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
-  const material = new THREE.LineBasicMaterial({ color: colour, transparent: opacity < 1, opacity });
-  return new THREE.LineSegments(geometry, material);
-}
+const lines = {
+  keyFrames: new Lines(layers.keyFrames, 0x4aa3ff), covisibility: new Lines(layers.covisibility, 0x3fbf7f, 0.35),
+  spanningTree: new Lines(layers.spanningTree, 0xe0c060, 0.8), loops: new Lines(layers.loops, 0xff40a0),
+  trajectory: new Lines(layers.trajectory, 0x40d0e0, 1, true), camera: new Lines(layers.camera, 0x50ff50),
+};
+const pointMaterial = new THREE.PointsMaterial({ size: 2, sizeAttenuation: false, vertexColors: THREE.VertexColors });
+const pointCloud = { object: null, colours: new Float32Array(0) };
 
 // ---- geometry from orbis poses ---------------------------------------------------------------
 // Twc: row-major 3x4 camera-to-world.
@@ -69,81 +123,105 @@ function transform(T, x, y, z) {
           T[8] * x + T[9] * y + T[10] * z + T[11]];
 }
 
-function pushFrustum(out, T, size) {
+function addFrustum(out, T, size) {
   const w = size, h = size * 0.75, z = size * 0.8;
   const apex = transform(T, 0, 0, 0);
   const corners = [[-w, -h], [w, -h], [w, h], [-w, h]].map(([x, y]) => transform(T, x, y, z));
-  for (let i = 0; i < 4; ++i) out.push(...apex, ...corners[i], ...corners[i], ...corners[(i + 1) % 4]);
+  for (let i = 0; i < 4; ++i) {
+    out.vertex(...apex);
+    out.vertex(...corners[i]);
+    out.vertex(...corners[i]);
+    out.vertex(...corners[(i + 1) % 4]);
+  }
 }
 
-function pointColours(points, maxKeyFrame) {
-  const colours = new Float32Array(points.length / 5 * 3);
-  let anyLocal = false;  // a finished run's folder or a map file has no local map: colour by age
-  for (let i = 4; i < points.length && !anyLocal; i += 5) anyLocal = points[i] === 1;
-  const byLocalMap = view.colouring === 'local' && anyLocal;
-  for (let i = 0, j = 0; i < points.length; i += 5, j += 3) {
+function drawPoints() {
+  if (store.grown || !pointCloud.object) {
+    if (pointCloud.object) {
+      pointCloud.object.geometry.dispose();
+      layers.points.remove(pointCloud.object);
+    }
+    pointCloud.colours = new Float32Array(store.capacity * 3);
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(store.positions, 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('color', new THREE.BufferAttribute(pointCloud.colours, 3).setUsage(THREE.DynamicDrawUsage));
+    pointCloud.object = new THREE.Points(geometry, pointMaterial);
+    pointCloud.object.frustumCulled = false;
+    layers.points.add(pointCloud.object);
+    store.grown = false;
+  }
+  colourPoints();
+  const geometry = pointCloud.object.geometry;
+  for (const attribute of [geometry.attributes.position, geometry.attributes.color]) {
+    attribute.updateRange = { offset: 0, count: 3 * store.count };  // not the spare capacity
+    attribute.needsUpdate = true;
+  }
+  geometry.setDrawRange(0, store.count);
+}
+
+// Red: the tracker's local map; grey: the rest. A finished run's folder or a map file has no
+// local map: by age then, blue old to yellow new.
+function colourPoints() {
+  const c = pointCloud.colours, local = store.local, n = store.count;
+  const byLocalMap = view.colouring === 'local' && local.subarray(0, n).includes(1);
+  const newest = store.newestKeyFrame();
+  for (let i = 0; i < n; ++i) {
     if (byLocalMap) {
-      const local = points[i + 4] === 1;
-      colours.set(local ? [1.0, 0.25, 0.25] : [0.75, 0.78, 0.85], j);
+      const on = local[i] === 1;
+      c[3 * i] = on ? 1.0 : 0.75;
+      c[3 * i + 1] = on ? 0.25 : 0.78;
+      c[3 * i + 2] = on ? 0.25 : 0.85;
     } else {
-      const age = maxKeyFrame > 0 ? points[i + 3] / maxKeyFrame : 1;  // 0 oldest, 1 newest
-      colours.set([0.25 + 0.75 * age, 0.45 + 0.4 * age, 1.0 - 0.8 * age], j);
+      const age = newest > 0 ? store.firstKeyFrame[i] / newest : 1;  // 0 oldest, 1 newest
+      c[3 * i] = 0.25 + 0.75 * age;
+      c[3 * i + 1] = 0.45 + 0.4 * age;
+      c[3 * i + 2] = 1.0 - 0.8 * age;
     }
   }
-  return colours;
 }
 
-function drawPoints(map) {
-  const positions = new Float32Array(map.points.length / 5 * 3);
-  for (let i = 0, j = 0; i < map.points.length; i += 5, j += 3) positions.set(map.points.slice(i, i + 3), j);
-  const maxKeyFrame = map.keyFrames.length ? map.keyFrames[map.keyFrames.length - 1].id : 0;
-  const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
-  geometry.setAttribute('color', new THREE.BufferAttribute(pointColours(map.points, maxKeyFrame), 3));
-  const material = new THREE.PointsMaterial({ size: view.pointSize, sizeAttenuation: false, vertexColors: THREE.VertexColors });
-  replaceLayer('points', new THREE.Points(geometry, material));
-}
-
-function drawKeyFrames(map) {
-  const centres = new Map();
-  const frusta = [];
-  for (const k of map.keyFrames) {
-    centres.set(k.id, [k.Twc[3], k.Twc[7], k.Twc[11]]);
-    pushFrustum(frusta, k.Twc, view.frustumSize);
+function drawKeyFrames() {
+  const { keyFrames, covisibility, spanningTree, loops } = lines;
+  for (const l of [keyFrames, covisibility, spanningTree, loops]) l.begin();
+  const centre = (k) => [k.Twc[3], k.Twc[7], k.Twc[11]];
+  for (const k of store.keyFrames.values()) {
+    addFrustum(keyFrames, k.Twc, view.frustumSize);
+    const edge = (out, other) => {
+      if (!other) return;
+      out.vertex(...centre(k));
+      out.vertex(...centre(other));
+    };
+    for (const c of k.covisibles) edge(covisibility, store.keyFrames.get(c));
+    edge(spanningTree, store.keyFrames.get(k.parent));
+    for (const l of k.loops) edge(loops, store.keyFrames.get(l));
   }
-  const covisibility = [], tree = [], loops = [];
-  for (const k of map.keyFrames) {
-    const a = centres.get(k.id);
-    for (const c of k.covisibles) if (centres.has(c)) covisibility.push(...a, ...centres.get(c));
-    if (centres.has(k.parent)) tree.push(...a, ...centres.get(k.parent));
-    for (const l of k.loops) if (centres.has(l)) loops.push(...a, ...centres.get(l));
-  }
-  replaceLayer('keyFrames', lineSegments(frusta, 0x4aa3ff));
-  replaceLayer('covisibility', lineSegments(covisibility, 0x3fbf7f, 0.35));
-  replaceLayer('spanningTree', lineSegments(tree, 0xe0c060, 0.8));
-  replaceLayer('loops', lineSegments(loops, 0xff40a0));
+  for (const l of [keyFrames, covisibility, spanningTree, loops]) l.end();
 }
 
-function drawTrajectory(map) {
-  const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.Float32BufferAttribute(map.trajectory, 3));
-  replaceLayer('trajectory', new THREE.Line(geometry, new THREE.LineBasicMaterial({ color: 0x40d0e0 })));
+function drawTrajectory() {
+  const t = store.trajectory;
+  lines.trajectory.begin();
+  for (let i = 0; i + 2 < t.length; i += 3) lines.trajectory.vertex(t[i], t[i + 1], t[i + 2]);
+  lines.trajectory.end();
 }
 
 function drawCurrentCamera(frame) {
-  if (!frame.Twc) return;
-  const frustum = [];
-  pushFrustum(frustum, frame.Twc, view.frustumSize * 2);
-  replaceLayer('camera', lineSegments(frustum, 0x50ff50));
+  if (!frame || !frame.Twc) return;
+  lines.camera.begin();
+  addFrustum(lines.camera, frame.Twc, view.frustumSize * 2);
+  lines.camera.end();
   view.cameraCentre = new THREE.Vector3(frame.Twc[3], frame.Twc[7], frame.Twc[11]).applyMatrix4(world.matrixWorld);
 }
 
 // ---- camera modes ------------------------------------------------------------------------------
-function mapBounds() {
-  world.updateMatrixWorld();
-  const box = new THREE.Box3().setFromObject(layers.keyFrames);
-  box.union(new THREE.Box3().setFromObject(layers.trajectory));
-  if (box.isEmpty()) box.setFromObject(layers.points);
+function mapBounds() {  // in three.js's world: keyframes and trajectory, or the points without them
+  const box = new THREE.Box3();
+  const add = (x, y, z) => box.expandByPoint(new THREE.Vector3(x, -y, -z));  // the world group's turn
+  for (const k of store.keyFrames.values()) add(k.Twc[3], k.Twc[7], k.Twc[11]);
+  const t = store.trajectory;
+  for (let i = 0; i + 2 < t.length; i += 3) add(t[i], t[i + 1], t[i + 2]);
+  const p = store.positions;
+  if (box.isEmpty()) for (let i = 0; i < store.count; ++i) add(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
   return box;
 }
 
@@ -171,116 +249,106 @@ function followCamera() {
   controls.update();
 }
 
-function showSceneState() { ui('scene-state').textContent = JSON.stringify(window.orbisScene); }
-
-// ---- panel ---------------------------------------------------------------------------------------
-function median(values) {
-  const s = [...values].sort((a, b) => a - b);
-  return s.length ? s[Math.floor(s.length / 2)] : 0;
-}
-
-function showTiming(name, ms) {
-  timings[name].push(ms);
-  if (timings[name].length > 100) timings[name].shift();
-  ui('t-' + name).textContent = ms.toFixed(1) + ' · ' + median(timings[name]).toFixed(1);
-}
-
-// The current image (a scaled-down JPEG; none from a run without images) under the keypoints,
-// drawn in the full image's pixels. Decoding is asynchronous: a frame whose image arrives after
-// a newer frame's is not drawn.
-const picture = { frame: null };
-function drawImage(frame) {
-  picture.frame = frame;
-  if (!frame.image) {
-    paintImage(frame, null);
-    return;
+// ---- drawing -----------------------------------------------------------------------------------
+// Brings the scene and the panel up to date with what has arrived, then renders.
+function drawMap() {
+  const t = store.trajectory;
+  if (store.trajectoryChanged && t.length >= 6) {  // frusta sized to the path: 2 % of its extent
+    const size = new THREE.Box3().setFromArray(t).getSize(new THREE.Vector3()).length();
+    const frustumSize = Math.min(0.3, Math.max(0.02, size * 0.02));
+    if (frustumSize !== view.frustumSize) store.keyFramesChanged = true;
+    view.frustumSize = frustumSize;
   }
-  const img = new Image();
-  img.onload = () => { if (picture.frame === frame) paintImage(frame, img); };
-  img.src = 'data:image/jpeg;base64,' + frame.image;
-}
-
-function paintImage(frame, img) {  // the counts beside the picture are of the frame it shows
-  const counts = [0, 0, 0, 0];
-  for (let i = 2; i < frame.keypoints.length; i += 3) counts[frame.keypoints[i]]++;
-  ui('matches').textContent = `${counts[1]} / ${counts[2]} / ${counts[3]}`;
-  const image = ui('image');
-  if (frame.width > 0 && (image.width !== frame.width || image.height !== frame.height)) {
-    image.width = frame.width;
-    image.height = frame.height;
-  }
-  const g = image.getContext('2d');
-  if (img) {
-    g.imageSmoothingEnabled = true;
-    g.drawImage(img, 0, 0, image.width, image.height);
-    window.orbisScene.images++;
-    showSceneState();
-  } else {
-    g.fillStyle = '#05070a';
-    g.fillRect(0, 0, image.width, image.height);
-  }
-  // As ORB-SLAM2's frame drawer: a box and a centre dot per keypoint; unmatched ones only dimly.
-  const k = frame.keypoints;
-  const r = Math.max(2, image.width / 160);
-  g.lineWidth = Math.max(1, image.width / 400);
-  for (let i = 0; i < k.length; i += 3) {
-    const state = k[i + 2];
-    g.strokeStyle = g.fillStyle = STATE_COLOURS[state];
-    g.globalAlpha = state === 0 ? 0.45 : 1;
-    if (state !== 0) g.strokeRect(k[i] - r, k[i + 1] - r, 2 * r, 2 * r);
-    g.fillRect(k[i] - 1, k[i + 1] - 1, 2, 2);
-  }
-  g.globalAlpha = 1;
-}
-
-function applyFrame(frame) {
-  window.orbisScene.frames = frame.index + 1;
-  ui('state').textContent = frame.state;
-  ui('state').className = 'n state-' + frame.state;
-  ui('frame').textContent = frame.index + (frame.newKeyFrame ? ' (new keyframe)' : '');
-  showTiming('extraction', frame.ms.extraction);
-  showTiming('tracking', frame.ms.tracking);
-  drawImage(frame);
-  drawCurrentCamera(frame);
-  followCamera();
-  requestRender();
-}
-
-function announceLoops(closures) {
-  for (let i = view.loopsSeen; i < closures.length; ++i) {
-    const c = closures[i];
-    const item = document.createElement('li');
-    item.textContent = `frame ${c.frame}: keyframe ${c.current} ↔ ${c.loop}, ${c.inliers} inliers`;
-    ui('loops').appendChild(item);
-    const banner = ui('banner');
-    banner.textContent = `loop closed: keyframe ${c.current} ↔ ${c.loop}`;
-    banner.style.display = 'block';
-    setTimeout(() => { banner.style.display = 'none'; }, 4000);
-  }
-  view.loopsSeen = closures.length;
-}
-
-function applyMap(map) {
-  Object.assign(window.orbisScene, { keyframes: map.keyFrames.length, points: map.points.length / 5,
-                                     loopClosures: map.loopClosures.length, live: map.live });
-  window.orbisScene.frames = Math.max(window.orbisScene.frames, map.frames);
-  if (map.trajectory.length >= 6) {  // frusta sized to the path: 2 % of its extent
-    const box = new THREE.Box3().setFromArray(map.trajectory);
-    view.frustumSize = Math.min(0.3, Math.max(0.02, box.getSize(new THREE.Vector3()).length() * 0.02));
-  }
-  drawPoints(map);
-  drawKeyFrames(map);
-  drawTrajectory(map);
-  announceLoops(map.loopClosures);
-  ui('mode').textContent = map.live ? '— live' : '— finished run';
-  ui('counts').textContent = `${map.keyFrames.length} / ${map.points.length / 5}`;
+  if (store.pointsChanged || store.keyFramesChanged || view.recolour) drawPoints();  // age colours follow keyframes
+  if (store.keyFramesChanged) drawKeyFrames();
+  if (store.trajectoryChanged) drawTrajectory();
+  const keyFramesChanged = store.keyFramesChanged;
+  store.pointsChanged = store.keyFramesChanged = store.trajectoryChanged = view.recolour = false;
+  Object.assign(window.orbisScene, { keyframes: store.keyFrames.size, points: store.count,
+                                     loopClosures: store.loopClosures.length, live: store.live });
+  window.orbisScene.frames = Math.max(window.orbisScene.frames, store.frames);
+  announceLoops(store.loopClosures);
+  setText('mode', store.live === null ? 'connecting…' : store.live ? '— live' : '— finished run');
+  setText('counts', `${store.keyFrames.size} / ${store.count}`);
   // The top view keeps the whole growing map in sight until the user moves the camera.
-  if (controls && map.keyFrames.length && (!view.fitted || (view.mode === 'top' && !view.userMoved))) {
+  if (controls && keyFramesChanged && store.keyFrames.size &&
+      (!view.fitted || (view.mode === 'top' && !view.userMoved))) {
     fitView(view.mode === 'top');
     view.fitted = true;
   }
   showSceneState();
-  requestRender();
+}
+
+// Interaction (the camera, a layer, the window) draws at the next animation frame; streamed
+// updates wait until their part's period has passed since it was last drawn.
+const drawing = {
+  pending: false, timer: null, interactive: false,
+  panel: { due: false, last: -Infinity, period: 1000 / PANEL_DRAWS_PER_SECOND },
+  view3d: { due: false, last: -Infinity,
+            period: 1000 / (software ? SOFTWARE_SCENE_DRAWS_PER_SECOND : PANEL_DRAWS_PER_SECOND) },
+};
+
+function draw() {
+  drawing.pending = false;
+  const now = performance.now();
+  const { panel, view3d } = drawing;
+  let render = drawing.interactive;
+  drawing.interactive = false;
+  if (!view.paused && panel.due && now - panel.last >= panel.period) {
+    panel.due = false;
+    panel.last = now;
+    if (view.frame && view.frame !== view.frameShown) {
+      view.frameShown = view.frame;
+      showFrame(view.frame);
+    }
+  }
+  if (!view.paused && view3d.due && (render || now - view3d.last >= view3d.period)) {
+    view3d.due = false;
+    view3d.last = now;
+    drawMap();
+    drawCurrentCamera(view.frame);
+    followCamera();
+    render = true;
+  }
+  if (renderer && render) renderer.render(scene, camera);
+  scheduleStreamed();
+}
+
+function requestDraw() {
+  if (drawing.pending) return;
+  drawing.pending = true;
+  requestAnimationFrame(draw);
+}
+
+function interactiveDraw() {  // at once: the user moved the camera, resized, toggled a layer
+  drawing.interactive = true;
+  requestDraw();
+}
+
+function scheduleStreamed() {
+  if (view.paused || drawing.pending || drawing.timer !== null) return;
+  let at = Infinity;
+  for (const part of [drawing.panel, drawing.view3d]) if (part.due) at = Math.min(at, part.last + part.period);
+  if (at === Infinity) return;
+  drawing.timer = setTimeout(() => {
+    drawing.timer = null;
+    requestDraw();
+  }, Math.max(0, at - performance.now()));
+}
+
+function streamed(panel, view3d) {  // what a message changed
+  drawing.panel.due ||= panel;
+  drawing.view3d.due ||= view3d;
+  scheduleStreamed();
+}
+
+function resize() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (!renderer || (canvas.width === w && canvas.height === h)) return;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(1, h);
+  camera.updateProjectionMatrix();
+  interactiveDraw();
 }
 
 // ---- controls and stream ---------------------------------------------------------------------------
@@ -290,7 +358,7 @@ function buildControls() {
     box.innerHTML = `<input type="checkbox" checked> ${label}`;
     box.firstChild.addEventListener('change', (e) => {
       layers[name].visible = e.target.checked;
-      requestRender();
+      interactiveDraw();
     });
     ui('layers').appendChild(box);
   }
@@ -298,25 +366,25 @@ function buildControls() {
     view.mode = e.target.value;
     view.userMoved = false;
     if (controls) fitView(view.mode === 'top');
+    interactiveDraw();
   });
   ui('point-size').addEventListener('input', (e) => {
-    view.pointSize = Number(e.target.value);
-    for (const p of layers.points.children) p.material.size = view.pointSize;
-    requestRender();
+    pointMaterial.size = Number(e.target.value);
+    interactiveDraw();
   });
   ui('colouring').addEventListener('change', (e) => {
     view.colouring = e.target.value;
-    if (view.latestMap) drawPoints(view.latestMap);
-    requestRender();
+    view.recolour = true;
+    drawing.view3d.due = true;
+    interactiveDraw();
   });
-  ui('pause').addEventListener('click', () => {
+  ui('pause').addEventListener('click', () => {  // the stream goes on into the store, unseen
     view.paused = !view.paused;
     ui('pause').textContent = view.paused ? 'resume' : 'pause';
-    if (!view.paused) {
-      if (view.latestMap) applyMap(view.latestMap);
-      if (view.latestFrame) applyFrame(view.latestFrame);
-    }
+    if (!view.paused) scheduleStreamed();
   });
+  if (window.ResizeObserver) new ResizeObserver(resize).observe(canvas);
+  else window.addEventListener('resize', resize);
 }
 
 // ?view=follow|free|top in the address picks the camera mode at the start.
@@ -328,6 +396,7 @@ function applyQuery() {
   }
 }
 
+// Each connection starts from an empty scene: the server sends the whole map or every change.
 // The stream closes by itself once the run has finished (its map will not change), or, with
 // ?maps=N in the address, after N map messages, or with ?loops=N after the map that shows the
 // N-th loop closure: a headless browser takes its screenshot once no request is open.
@@ -337,43 +406,27 @@ function connect() {
   const closeAfterLoops = Number(query.get('loops')) || Infinity;
   let maps = 0;
   const events = new EventSource('events');
+  events.onopen = () => store.reset();
   events.addEventListener('frame', (e) => {
-    view.latestFrame = JSON.parse(e.data);
-    if (!view.paused) applyFrame(view.latestFrame);
+    view.frame = JSON.parse(e.data);
+    streamed(true, true);  // the panel, and the current camera in 3-D
   });
   events.addEventListener('map', (e) => {
-    view.latestMap = JSON.parse(e.data);
-    if (!view.paused) applyMap(view.latestMap);
-    if (!view.latestMap.live || ++maps >= closeAfterMaps || view.latestMap.loopClosures.length >= closeAfterLoops)
+    const message = JSON.parse(e.data);
+    if (!store.apply(message)) {  // a change missed: start again from the whole map
       events.close();
+      connect();
+      return;
+    }
+    window.orbisScene[message.full ? 'fullMaps' : 'mapDeltas']++;
+    streamed(false, true);
+    if (!store.live || ++maps >= closeAfterMaps || store.loopClosures.length >= closeAfterLoops) events.close();
   });
-  events.onerror = () => { ui('mode').textContent = '— disconnected (retrying)'; };
-}
-
-function resize() {  // true when the canvas changed size
-  const w = canvas.clientWidth, h = canvas.clientHeight;
-  if (!renderer || (canvas.width === w && canvas.height === h)) return false;
-  renderer.setSize(w, h, false);
-  camera.aspect = w / Math.max(1, h);
-  camera.updateProjectionMatrix();
-  return true;
-}
-
-// Draws only when something changed (a message, the mouse, the window): a browser on the
-// machine that runs SLAM then takes little CPU from it.
-let needsRender = true;
-function requestRender() { needsRender = true; }
-
-function animate() {
-  requestAnimationFrame(animate);
-  if (resize()) needsRender = true;
-  if (renderer && needsRender) {
-    renderer.render(scene, camera);
-    needsRender = false;
-  }
+  events.onerror = () => setText('mode', '— disconnected (retrying)');
 }
 
 buildControls();
 applyQuery();
+resize();
 connect();
-animate();
+interactiveDraw();
