@@ -159,19 +159,22 @@ void SlamCore<Sensor>::saveMap(const std::filesystem::path& file) {
     mapper_->waitUntilIdle();
   }
   std::lock_guard lock(map_.mutex());
-  writeMapFile(file, map_, {sensorKind(), intrinsics_, vocabularyChecksum(*vocabulary_), 0, 0, 0, 0});
+  writeMapFile(file, map_,
+               {sensorKind(), intrinsics_, vocabularyChecksum(*vocabulary_), 0, 0, 0, 0, Sensor::kMetricScale});
 }
 
 template <SensorConfiguration Sensor>
-void SlamCore<Sensor>::loadMap(const std::filesystem::path& file) {
+MapFileInfo SlamCore<Sensor>::loadMap(const std::filesystem::path& file) {
   std::lock_guard lock(map_.mutex());
   if (frames_ != 0) throw fileError(file.string(), "a map can only be loaded before the first frame is tracked");
   const MapFileInfo info = readMapFile(file, map_, {sensorKind(), intrinsics_, vocabularyChecksum(*vocabulary_), 0, 0,
-                                                    vocabulary_->wordCount(), vocabulary_->nodeCount()});
+                                                    vocabulary_->wordCount(), vocabulary_->nodeCount(),
+                                                    Sensor::kMetricScale});
   for (KeyFrame* kf : map_.keyFrames()) database_.add(kf->id, kf->bowVector());
   loadedKeyFrames_ = info.keyFrames;
   // There is a map already: find the camera in it instead of starting a new one.
   if (loadedKeyFrames_ > 0) tracker_->startLost();
+  return info;
 }
 
 template <SensorConfiguration Sensor>
