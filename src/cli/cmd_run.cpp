@@ -147,8 +147,9 @@ void printReport(const RunReport& r, const RunOptions& options, bool json) {
     std::printf("%s%s%s\n", waits.empty() ? "" : " (frames waiting: ", waits.c_str(), waits.empty() ? "" : ")");
   }
   if (options.loadMap || r.relocalisationAttempts)
-    std::printf("relocalised    %zu of %zu attempts; %zu keyframes loaded\n", r.relocalisations,
-                r.relocalisationAttempts, r.keyFramesLoaded);
+    std::printf("relocalised    %zu of %zu attempts; %zu keyframes loaded%s\n", r.relocalisations,
+                r.relocalisationAttempts, r.keyFramesLoaded,
+                !r.loadedMapMetricScale ? "" : *r.loadedMapMetricScale ? " (metric scale)" : " (scale arbitrary)");
   if (options.denseCloud && r.densePoints)
     std::printf("dense cloud    %zu points in %s\n", r.densePoints, options.denseCloud->string().c_str());
   if (r.ateRmse)

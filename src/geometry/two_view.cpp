@@ -128,6 +128,9 @@ struct ChosenModel {
   TwoViewModel model = TwoViewModel::Fundamental;
   double homographyRatio = 0;
   ModelFit fit;
+  // F's fit, kept when H won by a margin too narrow to trust (R_H at most
+  // options.fundamentalFallbackRatio): tried if H's reconstruction is ambiguous.
+  std::optional<ModelFit> fundamentalFallback;
 };
 
 // Both RANSACs on the same sets, the choice by R_H, and the winner refitted on its inliers.
@@ -161,10 +164,12 @@ std::optional<ChosenModel> estimateModel(std::span<const TwoViewMatch> matches, 
   chosen.homographyRatio = homography.score.score / scoreSum;
   const bool useH = chosen.homographyRatio > options.homographyRatioThreshold;
   chosen.model = useH ? TwoViewModel::Homography : TwoViewModel::Fundamental;
+  if (useH && chosen.homographyRatio <= options.fundamentalFallbackRatio) chosen.fundamentalFallback = fundamental;
   chosen.fit = std::move(useH ? homography : fundamental);
   if (options.refitOnInliers) {
     if (useH) refitOnInliers(chosen.fit, fitH, scoreH);
     else refitOnInliers(chosen.fit, fitF, scoreF);
+    if (chosen.fundamentalFallback) refitOnInliers(*chosen.fundamentalFallback, fitF, scoreF);
   }
   return chosen;
 }
@@ -185,6 +190,36 @@ void refineFundamentalMotion(RankedMotions& ranked, std::span<const TwoViewMatch
   }
 }
 
+// The motion of one model's fit: its hypotheses ranked, the winner judged; result.model,
+// homographyRatio and the refusal before this call are the caller's.
+void reconstructFromModel(TwoViewModel model, const ModelFit& fit, std::span<const TwoViewMatch> matches,
+                          const Eigen::Matrix3d& K, const TwoViewOptions& options, TwoViewResult& result) {
+  result.model = model;
+  result.inliers = fit.score.inlierCount;
+  result.refusal = TwoViewRefusal::TooFewInliers;
+  if (result.inliers < options.minTriangulated) return;
+  const bool useH = model == TwoViewModel::Homography;
+  const std::vector<bool>& inliers = fit.score.inliers;
+  const std::vector<MotionHypothesis> motions = useH ? homographyMotions(fit.model, K) : essentialMotions(fit.model, K);
+  if (motions.empty()) {  // a homography of a pure rotation (or none): nothing to triangulate
+    result.refusal = TwoViewRefusal::LowParallax;
+    return;
+  }
+  RankedMotions ranked = rankMotions(motions, matches, inliers, K);
+  if (options.refineMotion && !useH) refineFundamentalMotion(ranked, matches, inliers, K);
+
+  result.goodPoints = ranked.bestCheck.good;
+  result.secondBestGood = ranked.secondBestGood;
+  result.parallaxDeg = ranked.bestCheck.parallaxDeg;
+  result.refusal = judge(ranked, result.inliers, options);
+  result.rotation = ranked.best.rotation;
+  result.translation = ranked.best.translation;
+  if (result.accepted()) {
+    result.points = std::move(ranked.bestCheck.points);
+    result.triangulated = std::move(ranked.bestCheck.triangulated);
+  }
+}
+
 }  // namespace
 
 std::string_view toString(TwoViewModel model) { return enumName(kModelNames, model); }
@@ -199,31 +234,16 @@ TwoViewResult initialiseTwoView(std::span<const TwoViewMatch> matches, const Eig
   std::optional<ChosenModel> chosen = estimateModel(matches, rng, options);
   result.refusal = TwoViewRefusal::TooFewInliers;
   if (!chosen) return result;
-  result.model = chosen->model;
   result.homographyRatio = chosen->homographyRatio;
-  result.inliers = chosen->fit.score.inlierCount;
-  if (result.inliers < options.minTriangulated) return result;
-
-  const bool useH = chosen->model == TwoViewModel::Homography;
-  const std::vector<bool>& inliers = chosen->fit.score.inliers;
-  const std::vector<MotionHypothesis> motions =
-      useH ? homographyMotions(chosen->fit.model, K) : essentialMotions(chosen->fit.model, K);
-  if (motions.empty()) {  // a homography of a pure rotation (or none): nothing to triangulate
-    result.refusal = TwoViewRefusal::LowParallax;
-    return result;
-  }
-  RankedMotions ranked = rankMotions(motions, matches, inliers, K);
-  if (options.refineMotion && !useH) refineFundamentalMotion(ranked, matches, inliers, K);
-
-  result.goodPoints = ranked.bestCheck.good;
-  result.secondBestGood = ranked.secondBestGood;
-  result.parallaxDeg = ranked.bestCheck.parallaxDeg;
-  result.refusal = judge(ranked, result.inliers, options);
-  result.rotation = ranked.best.rotation;
-  result.translation = ranked.best.translation;
-  if (result.accepted()) {
-    result.points = std::move(ranked.bestCheck.points);
-    result.triangulated = std::move(ranked.bestCheck.triangulated);
+  reconstructFromModel(chosen->model, chosen->fit, matches, K, options, result);
+  // A narrow H win whose two-fold plane ambiguity is unresolved says little about the scene:
+  // with little parallax any scene is nearly a homography. F's reconstruction gets its chance,
+  // under the same checks; it is kept only when it is accepted.
+  if (result.refusal == TwoViewRefusal::Ambiguous && chosen->fundamentalFallback) {
+    TwoViewResult fromF;
+    fromF.homographyRatio = result.homographyRatio;
+    reconstructFromModel(TwoViewModel::Fundamental, *chosen->fundamentalFallback, matches, K, options, fromF);
+    if (fromF.accepted()) result = std::move(fromF);
   }
   return result;
 }

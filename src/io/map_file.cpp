@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr char kMagic[8] = {'O', 'R', 'B', 'I', 'S', 'M', 'A', 'P'};
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 + 8 + 10 * 8 + 8 + 8;
+constexpr std::size_t kHeaderBytesVersion1 = 8 + 4 + 4 + 8 + 8 + 10 * 8 + 8 + 8;
+constexpr std::uint32_t kFirstVersionWithScale = 2;
 constexpr std::size_t kTrailerBytes = 8;
 
 // Plain records for the arrays (std::pair is not trivially copyable); none has padding.
@@ -205,6 +206,7 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
   w.putIntrinsics(info.intrinsics);
   w.put<std::uint64_t>(keyFrames.size());
   w.put<std::uint64_t>(points.size());
+  w.put<std::uint32_t>(info.metricScale ? 1 : 0);
 
   for (const KeyFrame* kf : keyFrames) {
     w.put<std::uint64_t>(kf->id);
@@ -263,17 +265,18 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
 
 namespace {
 
-// Checks size, magic, version, declared size and checksum of a whole map file; returns its header.
-MapFileInfo checkedHeader(const std::vector<char>& bytes, const std::string& file) {
-  if (bytes.size() < kHeaderBytes + kTrailerBytes)
+// Checks size, magic, version, declared size and checksum of a whole map file; returns its header
+// and sets headerEnd to where the keyframes begin (the header's length depends on the version).
+MapFileInfo checkedHeader(const std::vector<char>& bytes, const std::string& file, std::size_t& headerEnd) {
+  if (bytes.size() < kHeaderBytesVersion1 + kTrailerBytes)
     throw fileError(file, "truncated map file: " + std::to_string(bytes.size()) + " bytes, shorter than the header");
   if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     throw fileError(file, "not an orbis map file (bad magic)");
   Reader header(bytes, bytes.size(), file);
   for (std::size_t i = 0; i < sizeof kMagic; ++i) header.get<char>("magic");
   const auto version = header.get<std::uint32_t>("version");
-  if (version != kMapFileVersion)
-    throw fileError(file, "map file format version " + std::to_string(version) + ", this orbis reads version " +
+  if (version == 0 || version > kMapFileVersion)
+    throw fileError(file, "map file format version " + std::to_string(version) + ", this orbis reads versions 1 to " +
                               std::to_string(kMapFileVersion));
   MapFileInfo info;
   const auto sensor = header.get<std::uint32_t>("sensor");
@@ -293,25 +296,41 @@ MapFileInfo checkedHeader(const std::vector<char>& bytes, const std::string& fil
   info.intrinsics = header.getIntrinsics("camera");
   info.keyFrames = header.get<std::uint64_t>("keyframe count");
   info.mapPoints = header.get<std::uint64_t>("map point count");
+  if (version >= kFirstVersionWithScale) {
+    const auto scale = header.get<std::uint32_t>("scale flag");
+    if (scale > 1) header.fail("scale flag neither metric (1) nor arbitrary (0)");
+    info.metricScale = scale == 1;
+  } else {
+    info.metricScale = info.sensor != SensorKind::Monocular;  // version 1: monocular was the only such sensor
+  }
+  headerEnd = header.position();
   return info;
 }
 
 }  // namespace
 
-MapFileInfo readMapFileInfo(const fs::path& path) { return checkedHeader(readWholeFile(path), path.string()); }
+MapFileInfo readMapFileInfo(const fs::path& path) {
+  std::size_t headerEnd = 0;
+  return checkedHeader(readWholeFile(path), path.string(), headerEnd);
+}
 
 MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expected) {
   const std::string file = path.string();
   if (map.createdKeyFrames() != 0 || map.createdMapPoints() != 0)
     throw fileError(file, "a map file can only be loaded into an empty map");
   const std::vector<char> bytes = readWholeFile(path);
-  const MapFileInfo info = checkedHeader(bytes, file);
+  std::size_t headerEnd = 0;
+  const MapFileInfo info = checkedHeader(bytes, file, headerEnd);
   if (info.sensor != expected.sensor)
     throw fileError(file, "map made with sensor " + std::string(toString(info.sensor)) + ", this system's sensor is " +
                               std::string(toString(expected.sensor)));
   if (info.vocabularyChecksum != expected.vocabularyChecksum)
     throw fileError(file, "map made with another vocabulary (checksum " + std::to_string(info.vocabularyChecksum) +
                               ", this system's vocabulary has " + std::to_string(expected.vocabularyChecksum) + ")");
+  if (info.metricScale != expected.metricScale)
+    throw fileError(file, std::string("map with ") + (info.metricScale ? "metric" : "arbitrary") +
+                              " scale, this system's sensor needs " + (expected.metricScale ? "metric" : "arbitrary") +
+                              " scale");
   checkCamera(file, info.intrinsics, expected.intrinsics);
 
   // Parse everything before touching the map, so a defect leaves it empty.
@@ -337,7 +356,7 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
     std::vector<Observation> observations;
   };
   Reader r(bytes, bytes.size() - kTrailerBytes, file);
-  for (std::size_t i = 0; i < kHeaderBytes; ++i) r.get<char>("header");
+  for (std::size_t i = 0; i < headerEnd; ++i) r.get<char>("header");
   std::vector<KeyFrameRecord> keyFrames;
   std::unordered_map<std::uint64_t, std::size_t> keyFrameIndex;
   for (std::uint64_t k = 0; k < info.keyFrames; ++k) {

@@ -79,6 +79,7 @@ void writeReport(const fs::path& file, const RunReport& r) {
   w.endObject().endObject();
   w.field("seconds", r.seconds);
   w.field("keyframes_loaded", r.keyFramesLoaded);
+  if (r.loadedMapMetricScale) w.field("loaded_map_scale", *r.loadedMapMetricScale ? "metric" : "arbitrary");
   w.field("dense_points", r.densePoints);
   w.field("relocalisation_attempts", r.relocalisationAttempts).field("relocalisations", r.relocalisations);
   w.key("ate");
@@ -159,7 +160,7 @@ void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<doubl
   Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, vocabulary, slamOptions);
   slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {
-    slam.core().loadMap(*options.loadMap);
+    report.loadedMapMetricScale = slam.core().loadMap(*options.loadMap).metricScale;
     report.keyFramesLoaded = slam.core().loadedKeyFrames();
   }
   if (options.observer) {

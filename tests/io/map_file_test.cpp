@@ -2,12 +2,14 @@
 // (truncation, a flipped bit, another vocabulary, sensor or camera) is a clear orbis::Error.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 
 #include <unistd.h>
 
+#include "orbis/bow/vocabulary_file.hpp"
 #include "orbis/bow/vocabulary_training.hpp"
 #include "orbis/io/map_file.hpp"
 #include "orbis/util/error.hpp"
@@ -289,6 +291,78 @@ TEST(MapFile, InfoReadsTheHeaderAndChecksTheFile) {
   bytes[bytes.size() / 2] ^= 1;
   writeBytes(file, bytes);
   EXPECT_THROW(readMapFileInfo(file), Error);
+}
+
+}  // namespace
+
+namespace {
+
+// Where the header's fields sit (io/map_file.hpp): version at 8, declared size at 16, and the
+// scale flag (version 2) after the first 128 bytes.
+constexpr std::size_t kVersionOffset = 8, kSizeOffset = 16, kScaleFlagOffset = 128;
+
+// The declared size and the checksum made to agree with the bytes again, as a writer would.
+void reseal(std::vector<char>& bytes) {
+  const std::uint64_t size = bytes.size();
+  std::memcpy(bytes.data() + kSizeOffset, &size, sizeof size);
+  const std::uint64_t sum = bow::checksum64(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &sum, sizeof sum);
+}
+
+MapFileInfo monocularExpectation() {
+  MapFileInfo info = expectation();
+  info.sensor = SensorKind::Monocular;
+  info.metricScale = false;
+  return info;
+}
+
+TEST(MapFile, RecordsWhetherTheScaleIsMetric) {
+  Map map;
+  buildMap(map);
+  const fs::path file = tempFile("monocular.map");
+  writeMapFile(file, map, monocularExpectation());
+  EXPECT_FALSE(readMapFileInfo(file).metricScale);
+  Map loaded;
+  EXPECT_FALSE(readMapFile(file, loaded, monocularExpectation()).metricScale);
+  MapFileInfo metric = monocularExpectation();
+  metric.metricScale = true;
+  expectLoadError(file, metric, "map with arbitrary scale, this system's sensor needs metric scale");
+  EXPECT_TRUE(readMapFileInfo(savedMap("metric.map")).metricScale);
+  fs::remove(tempFile("metric.map"));
+
+  std::vector<char> bytes = readBytes(file);
+  bytes[kScaleFlagOffset] = 2;
+  reseal(bytes);
+  writeBytes(file, bytes);
+  expectLoadError(file, monocularExpectation(), "scale flag neither metric (1) nor arbitrary (0)");
+  fs::remove(file);
+}
+
+// A version 1 file (before the scale flag) still loads: its scale follows from its sensor.
+TEST(MapFile, VersionOneFilesLoadWithTheScaleOfTheirSensor) {
+  for (const bool monocular : {false, true}) {
+    Map map;
+    buildMap(map);
+    const fs::path file = tempFile("version1.map");
+    const MapFileInfo expected = monocular ? monocularExpectation() : expectation();
+    writeMapFile(file, map, expected);
+    std::vector<char> bytes = readBytes(file);
+    ASSERT_EQ(bytes[kVersionOffset], 2);
+    bytes[kVersionOffset] = 1;
+    bytes.erase(bytes.begin() + kScaleFlagOffset, bytes.begin() + kScaleFlagOffset + 4);
+    reseal(bytes);
+    writeBytes(file, bytes);
+    Map loaded;
+    const MapFileInfo info = readMapFile(file, loaded, expected);
+    EXPECT_EQ(info.metricScale, !monocular);
+    EXPECT_EQ(loaded.keyFrameCount(), map.keyFrameCount());
+    EXPECT_EQ(loaded.mapPointCount(), map.mapPointCount());
+    bytes[kVersionOffset] = 3;  // a newer format than this reader knows
+    reseal(bytes);
+    writeBytes(file, bytes);
+    expectLoadError(file, expected, "map file format version 3, this orbis reads versions 1 to 2");
+    fs::remove(file);
+  }
 }
 
 }  // namespace

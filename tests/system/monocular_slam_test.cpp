@@ -2,6 +2,7 @@
 // slam_pipeline_test.cpp and relocalisation_test.cpp:
 //  - a rendered loop with image noise: the map initialises within the first 30 frames, every
 //    frame after that is tracked, and the Sim(3)-aligned ATE stays under 1% of the path;
+//  - the same loop at 320x240 with stronger noise initialises within 30 frames too;
 //  - deterministic mode twice on the same frames: bit-identical trajectories;
 //  - a saved monocular map loads into a fresh system that localises in it without new keyframes;
 //  - a static camera, a pure rotation and a textureless view never start a map, and the
@@ -125,6 +126,30 @@ TEST(MonocularSlam, SyntheticLoopInitialisesEarlyAndTracksUnderOnePercentOfPath)
   // The first keyframe is tracked too (the reference of the accepted pair).
   EXPECT_GE(run.stats.tracked, run.stats.frames - start);
   EXPECT_LT(ate.stats.rmse, 0.01 * length);
+}
+
+// At 320x240 with noise the finest level keeps few repeatable corners: the windowed matches
+// fall under 100 within 5-8 frames of a reference, and under so little parallax H and F explain
+// the matches alike (R_H 0.46-0.49), so H won by the paper's 0.45 and its two-fold plane
+// ambiguity refused every attempt (seed 41: initialised at frame 66). Falling back to F's
+// reconstruction on such a narrow, ambiguous H win (two_view.hpp) initialises it early.
+TEST(MonocularSlam, LowResolutionLoopInitialisesWithinThirtyFrames) {
+  synth::SynthOptions options = monoOptions(300, 41);
+  options.width = 320;
+  options.height = 240;
+  options.fx = 250;
+  options.noiseSigma = 4;
+  synth::SyntheticSequence seq(options);
+  std::vector<synth::SynthFrame> frames;
+  for (int i = 0; i < 30; ++i) frames.push_back(seq.render(i, false, false));
+  const MonoRun run = runMono(options, frames);
+  std::cout << "[mono] 320x240 loop, seed 41: initialised at frame "
+            << (run.stats.initialisedAtFrame ? std::to_string(*run.stats.initialisedAtFrame) : "never") << " ("
+            << waits(run.stats) << ")\n";
+  ASSERT_TRUE(run.stats.initialisedAtFrame.has_value()) << waits(run.stats);
+  EXPECT_LT(*run.stats.initialisedAtFrame, 30u);
+  for (std::size_t i = *run.stats.initialisedAtFrame; i < run.states.size(); ++i)
+    EXPECT_EQ(run.states[i], TrackingState::Ok) << "frame " << i;
 }
 
 TEST(MonocularSlam, DeterministicModeIsBitIdentical) {

@@ -6,7 +6,8 @@
 // initialiseTwoView() estimates a homography (normalised DLT) and a fundamental matrix
 // (normalised eight-point, rank 2) by RANSAC on the SAME minimal sets, scores both with the
 // symmetric transfer error under χ² gates, picks H when R_H = S_H / (S_H + S_F) > 0.45 and F
-// otherwise, refits the winner on its inliers, recovers the motion (Faugeras' eight
+// otherwise (a narrow H win whose motion is ambiguous falls back to F's, see
+// fundamentalFallbackRatio), refits the winner on its inliers, recovers the motion (Faugeras' eight
 // homography solutions, or the four (R, t) of E = KᵀFK), triangulates every inlier under each
 // candidate motion with the cheirality, parallax and reprojection checks, and refines the best
 // motion on the Sampson distance (the linear fits are biased for sideways motion). It accepts only
@@ -51,6 +52,12 @@ std::string_view toString(TwoViewRefusal refusal);
 struct TwoViewOptions {
   int ransacIterations = 200;       // ORB-SLAM's; each draws one 8-point set used by H and F
   double homographyRatioThreshold = 0.45;  // choose H when R_H exceeds this
+  // H won by a margin too narrow to trust (R_H at most this) and its reconstruction is
+  // ambiguous: F's reconstruction is tried and kept if accepted. ORB-SLAM3 chooses H only
+  // above 0.50; below, any scene seen under little parallax is nearly a homography, so H wins
+  // ties and its plane ambiguity refuses frame after frame (rendered 320x240 loops: 16-73
+  // frames). 0 turns the fallback off (the paper's rule alone).
+  double fundamentalFallbackRatio = 0.5;
   double minParallaxDeg = 1.0;
   int minTriangulated = 50;
   double minGoodFractionOfInliers = 0.9;  // the winner triangulates at least this share

@@ -2,7 +2,9 @@
 //
 // Contract: a map file is little-endian binary:
 //   header: magic "ORBISMAP", format version (kMapFileVersion), sensor kind, total file size,
-//           vocabulary checksum, the camera (MapIntrinsics), keyframe and map-point counts;
+//           vocabulary checksum, the camera (MapIntrinsics), keyframe and map-point counts,
+//           and (version 2) whether the map's scale is metric (1) or arbitrary (0: a monocular
+//           map, in the unit of its initialisation);
 //   keyframes (good ones, by id): frame index, timestamp, pose, intrinsics, features (keypoints,
 //           undistorted keypoints, descriptors, uRight, depth, close-depth threshold, scale
 //           tables, grid bounds — the grid is rebuilt on load), BoW and feature vectors,
@@ -18,7 +20,9 @@
 // the remaining bytes cannot hold, indices out of range, non-finite poses and positions, graphs
 // the running system could not have built (self edges, a cycle in the spanning tree, a keypoint
 // held by two points, word or node ids beyond the caller's vocabulary). It throws orbis::Error
-// naming the file and the defect — nothing is added to the map on failure.
+// naming the file and the defect — nothing is added to the map on failure. Version 1 files (no
+// scale field) still load: their scale follows from the sensor, since monocular was the only
+// sensor without metric scale when version 2 added the field.
 #pragma once
 
 #include <cstdint>
@@ -30,7 +34,7 @@
 
 namespace orbis {
 
-inline constexpr std::uint32_t kMapFileVersion = 1;
+inline constexpr std::uint32_t kMapFileVersion = 2;
 
 struct MapFileInfo {
   SensorKind sensor = SensorKind::Stereo;
@@ -41,6 +45,9 @@ struct MapFileInfo {
   // node id of the keyframes' BoW and feature vectors must be below them (a corrupt id would
   // size the keyframe database's inverted index, or index the vocabulary, far out of bounds).
   std::uint64_t vocabularyWords = 0, vocabularyNodes = 0;
+  // False: the map's unit is arbitrary (a monocular map; Sensor::kMetricScale). Read back from
+  // the file and checked against the caller's.
+  bool metricScale = true;
 };
 
 // Identifies the vocabulary a map's BoW vectors belong to (checksum of its whole file block).

@@ -53,6 +53,7 @@ struct RunReport {
   std::vector<std::string> warnings;
   double seconds = 0;
   std::size_t keyFramesLoaded = 0;  // from RunOptions::loadMap
+  std::optional<bool> loadedMapMetricScale;  // from its file; false: the map's unit is arbitrary
   std::size_t densePoints = 0;      // voxels in RunOptions::denseCloud
   std::size_t relocalisationAttempts = 0, relocalisations = 0;
   // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "orbis/bow/keyframe_database.hpp"
+#include "orbis/io/map_file.hpp"
 #include "orbis/io/trajectory.hpp"
 #include "orbis/loop/loop_closer.hpp"
 #include "orbis/map/map.hpp"
@@ -80,8 +81,10 @@ class SlamCore {
 
   // Map files (io/map_file.hpp). saveMap waits for local mapping to finish its queue. loadMap
   // needs a core that has not tracked yet; tracking then starts lost and relocalises in the map.
+  // The file records whether the map's scale is metric (Sensor::kMetricScale); loadMap returns
+  // the file's header.
   void saveMap(const std::filesystem::path& file);
-  void loadMap(const std::filesystem::path& file);
+  MapFileInfo loadMap(const std::filesystem::path& file);
   static constexpr SensorKind sensorKind() { return Sensor::kKind; }
   // Relocalisation attempts and successes; keyframes loaded from a map file.
   RelocalisationStats relocalisationStats() const;

@@ -102,6 +102,8 @@ bool Tracker<Sensor>::initialiseFromTwoViews(FrameT& f)
   const int matched = searchForInitialization(reference, *f.features, initialPredicted_,
                                                         options_.initialisationWindow,
                                                         tracking_detail::kInitialisationMatchRatio, true, matches12);
+  note("initialisation_reference", static_cast<double>(initialReference_->index));
+  note("initialisation_matches", matched);
   if (matched < options_.minInitialisationMatches) {
     initialisationRefusal_ = TwoViewRefusal::TooFewMatches;
     ++initialisationWaits_[std::string(toString(initialisationRefusal_))];
@@ -122,6 +124,12 @@ bool Tracker<Sensor>::initialiseFromTwoViews(FrameT& f)
   }
   const TwoViewResult twoView = initialiseTwoView(matches, f.camera->K(), initialisationRng_);
   initialisationRefusal_ = twoView.refusal;
+  note("initialisation_inliers", twoView.inliers);
+  note("initialisation_good", twoView.goodPoints);
+  note("initialisation_second_good", twoView.secondBestGood);
+  note("initialisation_parallax_deg", twoView.parallaxDeg);
+  note("initialisation_homography_ratio", twoView.homographyRatio);
+  note("initialisation_homography", twoView.model == TwoViewModel::Homography);
   if (!twoView.accepted()) {
     ++initialisationWaits_[std::string(toString(initialisationRefusal_))];
     return false;

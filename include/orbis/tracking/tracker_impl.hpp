@@ -420,7 +420,14 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
     return false;
   const int minObservations = keyFrames <= 2 ? 2 : 3;
   const int referenceMatches = reference_->trackedPoints(minObservations);
-  const bool mapperIdle = mapper_ ? mapper_->acceptsKeyFrames() : true;
+  bool mapperIdle = mapper_ ? mapper_->acceptsKeyFrames() : true;
+  // A monocular keyframe makes map only once mapping has triangulated it against its neighbours.
+  // Between two keyframes the mapper accepts more before it has taken the queued one, so a
+  // tracker that runs ahead of it (frames fed faster than the camera's rate, a loaded machine)
+  // read "idle" frame after frame and queued a keyframe per frame: keyframes a frame apart, whose
+  // pairs triangulate little, processed without local BA while tracking ran out of map (KITTI 06,
+  // threaded: 6 queued, inliers 144 -> 32). Mapping with a keyframe queued is not idle.
+  if constexpr (!Sensor::kMetricScale) mapperIdle = mapperIdle && (!mapper_ || mapper_->queuedKeyFrames() == 0);
 
   int trackedClose = 0, untrackedClose = 0;
   for (std::size_t i = 0; i < current_.size(); ++i) {

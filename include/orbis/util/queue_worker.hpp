@@ -5,8 +5,9 @@
 // that waits for items (or a wake-up) and calls serve() with busy() set; serve() pops items itself
 // (pop()) and returns when it wants to wait again. Without start() nothing runs on its own: the
 // owner drains the queue on its thread (deterministic mode). waitUntilIdle(drainInline) blocks
-// until the queue is empty and the worker idle, or, with no worker, drains it inline. stop()
-// wakes and joins the worker; items still queued stay queued.
+// until the queue is empty and the worker idle, or, with no worker, drains it inline;
+// waitUntilIdleFor(budget) waits the same way for at most budget (threaded). stop() wakes and
+// joins the worker; items still queued stay queued.
 #pragma once
 
 #include <atomic>
@@ -79,6 +80,16 @@ class QueueWorker {
         return;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+
+  // Threaded: as waitUntilIdle, but for at most `budget`; true when idle.
+  bool waitUntilIdleFor(std::chrono::steady_clock::duration budget, const std::function<bool()>& alsoIdle = {}) {
+    const auto deadline = std::chrono::steady_clock::now() + budget;
+    while (true) {
+      if (size() == 0 && !busy() && (!alsoIdle || alsoIdle())) return true;
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   }
 

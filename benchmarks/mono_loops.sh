@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Rendered monocular loops with image noise (issue 17, "Must show"): for each seed the loop is
+# rendered (300 frames + 75 over known ground, 320x240, fx 250, noise 4) and run as monocular in
+# --deterministic mode with and without --no-loop. One row per seed:
+#   init      the frame the map initialised at (must be below 30), and what the frames before waited on
+#   tracked   frames tracked after initialisation / frames after initialisation
+#   loops     each closure: frame and the Sim(3) scale of the correction
+#   ATE       Sim(3)-aligned ATE (all frames) with loop closing / --no-loop, and their ratio (<= 1/3)
+#   scale     the estimate's scale over the last 60 frames against the first 60 tracked (each
+#             stretch Sim(3)-aligned to the ground truth on its own): 1 is no scale drift;
+#             --no-loop (before the correction) and with loop closing (after it)
+#
+# Usage: benchmarks/mono_loops.sh [SEED...]        (default seeds 41 42 43)
+#   ORBIS  the binary (default build/release/orbis); WORK a scratch folder (renders are kept
+#   there and reused; default: a temporary one). SIZE="W H FX" overrides 320 240 250.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+orbis=${ORBIS:-$root/build/release/orbis}
+work=${WORK:-$(mktemp -d)}
+read -r width height fx <<<"${SIZE:-320 240 250}"
+seeds=("$@")
+((${#seeds[@]})) || seeds=(41 42 43)
+mkdir -p "$work"
+
+# The estimate's scale over trajectory lines [from, to) against the ground truth (sim3 ATE alignment).
+stretch_scale() {  # GT EST FROM TO
+  local part=$work/stretch.txt
+  grep -v '^#' "$2" | sed -n "$(($3 + 1)),$4p" >"$part"
+  "$orbis" eval ate "$1" "$part" --align sim3 --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["scale"])'
+}
+scale_drift() {  # GT EST: last 60 against first 60
+  local n
+  n=$(grep -vc '^#' "$2")
+  python3 -c "print(f'{$(stretch_scale "$1" "$2" $((n - 60)) "$n") / $(stretch_scale "$1" "$2" 0 60):.3f}')"
+}
+
+printf '%-5s %-6s %-14s %-28s %-30s %s\n' seed init tracked "loops (frame:scale)" "ATE mm loop / no-loop (ratio)" \
+  "scale end/start no-loop -> loop"
+for seed in "${seeds[@]}"; do
+  seq=$work/mono_${width}x${height}_$seed
+  [[ -f $seq/settings_mono.yaml ]] || "$orbis" synth "$seq" --frames 300 --extra 75 --width "$width" \
+    --height "$height" --fx "$fx" --noise 4 --seed "$seed" --threads 2 >/dev/null
+  for mode in loop noloop; do
+    flags=(--deterministic)
+    [[ $mode == noloop ]] && flags+=(--no-loop)
+    "$orbis" run tum "$seq" --settings "$seq/settings_mono.yaml" --sensor mono "${flags[@]}" \
+      --out "$work/run_${seed}_$mode" >"$work/run_${seed}_$mode.log" 2>&1
+  done
+  drift_open=$(scale_drift "$seq/groundtruth.txt" "$work/run_${seed}_noloop/trajectory.txt")
+  drift_closed=$(scale_drift "$seq/groundtruth.txt" "$work/run_${seed}_loop/trajectory.txt")
+  python3 - "$seed" "$work/run_${seed}_loop/report.json" "$work/run_${seed}_noloop/report.json" \
+    "$drift_open" "$drift_closed" <<'PY'
+import json, sys
+seed, closed, opened = sys.argv[1], json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
+drift_open, drift_closed = sys.argv[4], sys.argv[5]
+init = closed["initialisation"]["frame"]
+after = closed["frames"] - init
+loops = " ".join(f'{l["frame"]}:{l["scale"]:.3f}' for l in closed["loops"]) or "none"
+a, b = closed["ate"]["rmse"] * 1000, opened["ate"]["rmse"] * 1000
+print(f'{seed:<5} {init:<6} {closed["frames_tracked"] - 1}/{after:<10} {loops:<28} '
+      f'{a:6.1f} / {b:6.1f} ({a / b:.3f})        {drift_open} -> {drift_closed}')
+waits = closed["initialisation"]["waits"]
+print(f'      waited on: ' + ", ".join(f"{k} {v}" for k, v in sorted(waits.items())))
+PY
+done
