@@ -13,9 +13,9 @@
 
 // Streamed updates of the panel (state, counts, timing, camera image) and of the 3-D view, at most
 // this many a second. Without a GPU every 3-D redraw costs CPU (about 15 ms of Chromium's GPU
-// process with SwiftShader, measured): twice a second then.
+// process with SwiftShader, measured): once a second then.
 const PANEL_DRAWS_PER_SECOND = 5;
-const SOFTWARE_SCENE_DRAWS_PER_SECOND = 2;
+const SOFTWARE_SCENE_DRAWS_PER_SECOND = 1;
 const LAYERS = {
   points: 'map points', keyFrames: 'keyframes', covisibility: 'covisibility', spanningTree: 'spanning tree',
   loops: 'loop edges', trajectory: 'trajectory', camera: 'current camera',
