@@ -13,9 +13,9 @@
 
 // Streamed updates of the panel (state, counts, timing, camera image) and of the 3-D view, at most
 // this many a second. Without a GPU every 3-D redraw costs CPU (about 15 ms of Chromium's GPU
-// process with SwiftShader, measured): twice a second then.
+// process with SwiftShader, measured): once a second then.
 const PANEL_DRAWS_PER_SECOND = 5;
-const SOFTWARE_SCENE_DRAWS_PER_SECOND = 2;
+const SOFTWARE_SCENE_DRAWS_PER_SECOND = 1;
 const LAYERS = {
   points: 'map points', keyFrames: 'keyframes', covisibility: 'covisibility', spanningTree: 'spanning tree',
   loops: 'loop edges', trajectory: 'trajectory', camera: 'current camera',
@@ -25,7 +25,7 @@ window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosure
                       fullMaps: 0, mapDeltas: 0 };
 const store = new SceneStore();
 const view = { paused: false, frame: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
-               mode: 'follow', cameraCentre: null, userMoved: false, recolour: false };
+               mode: 'follow', cameraCentre: null, userMoved: false, recolour: false, pointKey: null };
 
 // ---- three.js scene ------------------------------------------------------------------------
 function softwareWebGl() {  // SwiftShader and the like: every pixel costs CPU
@@ -164,6 +164,7 @@ function drawPoints() {
 function colourPoints() {
   const c = pointCloud.colours, local = store.local, n = store.count;
   const byLocalMap = view.colouring === 'local' && local.subarray(0, n).includes(1);
+  showPointKey(byLocalMap);
   const newest = store.newestKeyFrame();
   for (let i = 0; i < n; ++i) {
     if (byLocalMap) {
@@ -355,7 +356,10 @@ function resize() {
 function buildControls() {
   for (const [name, label] of Object.entries(LAYERS)) {
     const box = document.createElement('label');
-    box.innerHTML = `<input type="checkbox" checked> ${label}`;
+    // Each line layer's label in its colour: the 3-D view has no other key.
+    const colour = lines[name] ? lines[name].material.color.getStyle() : null;
+    box.innerHTML = `<input type="checkbox" checked> ` +
+                    (colour ? `<span class="dot" style="background:${colour};margin-left:0"></span>` : '') + label;
     box.firstChild.addEventListener('change', (e) => {
       layers[name].visible = e.target.checked;
       interactiveDraw();
@@ -385,6 +389,15 @@ function buildControls() {
   });
   if (window.ResizeObserver) new ResizeObserver(resize).observe(canvas);
   else window.addEventListener('resize', resize);
+}
+
+// The points' colours as colourPoints chose them, beside the choice of colouring.
+function showPointKey(byLocalMap) {
+  if (byLocalMap === view.pointKey) return;
+  view.pointKey = byLocalMap;
+  ui('point-key').innerHTML = byLocalMap
+    ? '<span class="dot" style="background:#ff4040"></span>local map<span class="dot" style="background:#bfc7d9"></span>other'
+    : '<span class="dot" style="background:#4073ff"></span>oldest keyframe<span class="dot" style="background:#ffd933"></span>newest';
 }
 
 // ?view=follow|free|top in the address picks the camera mode at the start.
@@ -426,6 +439,7 @@ function connect() {
 }
 
 buildControls();
+showPointKey(true);
 applyQuery();
 resize();
 connect();
