@@ -92,8 +92,7 @@ class TumRgbdReader final : public DatasetReader {
   Error noDepth(const std::string& why) const {
     return Error(root_.string(), "",
                  "no depth maps for the colour images (" + why +
-                     "), so it cannot run as RGB-D; colour alone is monocular (--sensor mono), "
-                     "which orbis does not run yet");
+                     "), so it cannot run as RGB-D; run it as monocular: --sensor mono");
   }
 
   DatasetKind kind() const override { return DatasetKind::TumRgbd; }
