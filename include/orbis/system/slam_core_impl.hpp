@@ -65,7 +65,10 @@ template <SensorConfiguration Sensor>
 TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> features, double timestamp,
                                     double extractionMs, const cv::Mat& image) {
   using Clock = std::chrono::steady_clock;
-  const Clock::time_point start = Clock::now();
+  // Read only by the frame observer and threaded monocular's wait for mapping below: no clock
+  // call on the stereo/RGB-D path without a viewer.
+  const bool timed = frameObserver_ || (!Sensor::kMetricScale && !options_.deterministic);
+  const Clock::time_point start = timed ? Clock::now() : Clock::time_point{};
   std::shared_ptr<const FrameFeatures> observed = frameObserver_ ? features : nullptr;
   Frame<Camera> frame;
   frame.index = frames_++;
