@@ -8,6 +8,11 @@
 #             the stream (curl: the event stream only; chromium: the page, rendering headless,
 #             which also puts the browser's own CPU on the machine).
 #   SETTLE    seconds of rest before each run (default 2)
+#   PACING    "fast", "realtime" or both (default "fast realtime"): fast feeds the frames as fast
+#             as tracking takes them (both cores busy: any browser CPU is taken from SLAM);
+#             realtime runs `orbis run --realtime`, each frame at its timestamp, as from a live
+#             camera (how someone watching the viewer runs it). Each mode gets its own rounds and
+#             summary.
 #   ORBIS_BASELINE  another binary (an older build): each round then runs it with the viewer
 #             too ("base"), between the run without and the run with ORBIS's viewer ("on"), so
 #             the two viewers meet the same machine load.
@@ -28,16 +33,18 @@ baseline=${ORBIS_BASELINE:-}
 client=${VIEWER_CLIENT:-curl}
 port=${VIEWER_PORT:-18791}
 settle=${SETTLE:-2}
+pacing=${PACING:-fast realtime}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-per_frame_ms() {  # report.json -> "extraction tracking observer sum"
+per_frame_ms() {  # report.json -> "extraction tracking observer sum run-seconds"
   python3 - "$1" <<'PY'
 import json, sys
-t = json.load(open(sys.argv[1]))["timing_ms"]
+r = json.load(open(sys.argv[1]))
+t = r["timing_ms"]
 m = lambda s: t[s]["median"] if s in t else 0.0
 e, k, o = m("tracking: ORB extraction"), m("tracking: total"), m("tracking: observer")
-print("%.3f %.3f %.3f %.3f" % (e, k, o, e + k + o))
+print("%.3f %.3f %.3f %.3f %.2f" % (e, k, o, e + k + o, r["seconds"]))
 PY
 }
 
@@ -46,7 +53,7 @@ run() {  # run NAME BINARY [orbis args...]: CPU seconds (user + system) into NAM
   shift 2
   sleep "$settle"  # the previous run's browser is still closing: every run starts as calm
   /usr/bin/time -f "%U %S" -o "$work/$name.time" "$binary" run tum "$sequence" \
-    --settings "$root/examples/settings/TUM3.yaml" --out "$work/$name" "$@" >"$work/$name.log" 2>&1
+    --settings "$root/examples/settings/TUM3.yaml" --out "$work/$name" "${pacing_args[@]}" "$@" >"$work/$name.log" 2>&1
   awk '{print $1 + $2}' "$work/$name.time" >"$work/$name.cpu"
 }
 
@@ -87,7 +94,16 @@ print('%.2f' % (sum(m['cpu_seconds'].values()) - sum(m['cpu_seconds_before_page'
 
 kinds=(off on)
 [[ -z $baseline ]] || kinds=(off base on)
-printf "%-7s %11s %9s %9s %9s %8s %10s\n" run extraction tracking observer "sum ms" "CPU s" "browser s"
+# The sequence's own duration, first to last frame: what a realtime run cannot be shorter than.
+duration=$(awk '!/^#/ && NF {if (first == "") first = $1; last = $1} END {printf "%.2f", last - first}' "$sequence/rgb.txt")
+for mode in $pacing; do
+case $mode in
+  fast) pacing_args=() ;;
+  realtime) pacing_args=(--realtime) ;;
+  *) echo "PACING: fast or realtime, not $mode" >&2; exit 2 ;;
+esac
+echo "== pacing: $mode ($client; load average $(cut -d' ' -f1-3 /proc/loadavg); the sequence lasts $duration s)"
+printf "%-7s %11s %9s %9s %9s %8s %8s %10s\n" run extraction tracking observer "sum ms" "run s" "CPU s" "browser s"
 for kind in "${kinds[@]}"; do : >"$work/$kind.sums"; done
 for round in $(seq "$rounds"); do
   for kind in "${kinds[@]}"; do
@@ -96,9 +112,9 @@ for round in $(seq "$rounds"); do
       base) with_viewer base "$baseline" ;;
       on) with_viewer on "$orbis" ;;
     esac
-    read -r e k o sum < <(per_frame_ms "$work/$kind/report.json")
+    read -r e k o sum secs < <(per_frame_ms "$work/$kind/report.json")
     echo "$sum $(cat "$work/$kind.cpu") $(cat "$work/$kind.browser")" >>"$work/$kind.sums"
-    printf "%-7s %11s %9s %9s %9s %8s %10s\n" "$kind $round" "$e" "$k" "$o" "$sum" "$(cat "$work/$kind.cpu")" \
+    printf "%-7s %11s %9s %9s %9s %8s %8s %10s\n" "$kind $round" "$e" "$k" "$o" "$sum" "$secs" "$(cat "$work/$kind.cpu")" \
       "$(cat "$work/$kind.browser")"
     # What the viewer's own thread did (messages, bytes, its CPU): the cost that is not on tracking's.
     [[ $kind == off ]] || grep -h "^viewer: [0-9]" "$work/$kind.log" | sed 's/^/          /' || true
@@ -117,8 +133,10 @@ for k in kinds[1:]:
         print("%s tracking time per frame: %.2f ms without, %.2f ms with %s (%+.1f%%)"
               % (what, a, b, label[k], 100 * (b - a) / a))
     # Each run against the run without a viewer in its own round: the load of the moment cancels.
-    ratio = statistics.median(b / a for a, b in zip(ms["off"], ms[k]))
-    print("median over the rounds of tracking time per frame with %s / without: %+.1f%%" % (label[k], 100 * (ratio - 1)))
+    ratios = [b / a for a, b in zip(ms["off"], ms[k])]
+    print("per-round ratios with %s / without: %s" % (label[k], " ".join("%+.1f%%" % (100 * (r - 1)) for r in ratios)))
+    print("median over the rounds of tracking time per frame with %s / without: %+.1f%%"
+          % (label[k], 100 * (statistics.median(ratios) - 1)))
     a, b = statistics.median(cpu["off"]), statistics.median(cpu[k])
     print("median CPU of the orbis run: %.2f s without, %.2f s with %s (%+.1f%%)" % (a, b, label[k], 100 * (b - a) / a))
     browser = [float(r[2]) for r in runs[k] if r[2] != "-"]
@@ -127,3 +145,4 @@ for k in kinds[1:]:
               % (label[k], statistics.median(browser)))
 PY
 [[ $client == chromium ]] || echo "(viewer client: curl; $(grep -c '^event:' "$work/events.txt" 2>/dev/null || echo 0) events in the last run)"
+done
