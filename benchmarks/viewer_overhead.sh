@@ -106,7 +106,11 @@ echo "== pacing: $mode ($client; load average $(cut -d' ' -f1-3 /proc/loadavg); 
 printf "%-7s %11s %9s %9s %9s %8s %8s %10s\n" run extraction tracking observer "sum ms" "run s" "CPU s" "browser s"
 for kind in "${kinds[@]}"; do : >"$work/$kind.sums"; done
 for round in $(seq "$rounds"); do
-  for kind in "${kinds[@]}"; do
+  # Every other round in the reverse order (off on, on off, ...): a load that drifts during a
+  # round, or a run that leaves the machine busier for the next, does not always favour one kind.
+  order=("${kinds[@]}")
+  (( round % 2 )) || order=($(printf '%s\n' "${kinds[@]}" | tac))
+  for kind in "${order[@]}"; do
     case $kind in
       off) run off "$orbis"; echo "-" >"$work/off.browser" ;;
       base) with_viewer base "$baseline" ;;
