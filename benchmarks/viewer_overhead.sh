@@ -8,20 +8,15 @@
 #             the stream (curl: the event stream only; chromium: the page, rendering headless,
 #             which also puts the browser's own CPU on the machine).
 #   SETTLE    seconds of rest before each run (default 2)
-#   BROWSER_SESSION  own (default) or same: with chromium, whether the browser runs in a session of
-#             its own (setsid), as a browser started from the desktop does beside orbis started
-#             from a terminal, or in the benchmark's. Linux's autogroup scheduling shares the CPU
-#             between sessions; in the same session a busy browser (root's Chromium raises its
-#             browser and GPU processes to nice -8) made the session take CPU from the machine's
-#             other sessions, and tracking came out 45-60 % *faster* with the viewer open.
-#   PACING    "fast", "realtime" or both (default "fast realtime"): fast feeds the frames as fast
-#             as tracking takes them (both cores busy: any browser CPU is taken from SLAM);
-#             realtime runs `orbis run --realtime`, each frame at its timestamp, as from a live
-#             camera (how someone watching the viewer runs it). Each mode gets its own rounds and
-#             summary.
-#   ORBIS_BASELINE  another binary (an older build): each round then runs it with the viewer
-#             too ("base"), between the run without and the run with ORBIS's viewer ("on"), so
-#             the two viewers meet the same machine load.
+#   BROWSER_AS  user (default) or root: with chromium, how the browser is started. user: in a
+#             session of its own (setsid) and without the right to raise its priority (setpriv
+#             drops CAP_SYS_NICE), as a browser started from the desktop beside orbis in a
+#             terminal. root: in the benchmark's session, with root's rights, under which Chromium
+#             raises its browser and GPU processes to nice -8 (no desktop browser can). Either
+#             way, on a 2-core machine shared with other jobs, tracking came out faster with the
+#             viewer open than without in most rounds (as root: medians of per-round ratios
+#             -14 % to -53 % over 5 invocations; as user -22 % over 3 rounds): runs there measure
+#             the other jobs' scheduling more than the viewer; see the README.
 # Runs threaded (as in real time). Per run, from report.json: medians of ORB extraction, of the
 # tracking stages ("tracking: total") and of the observer's per-frame copy ("tracking: observer",
 # only with the viewer), their sum; the CPU seconds of the whole orbis process; with Chromium,
@@ -39,7 +34,7 @@ baseline=${ORBIS_BASELINE:-}
 client=${VIEWER_CLIENT:-curl}
 port=${VIEWER_PORT:-18791}
 settle=${SETTLE:-2}
-browser_session=${BROWSER_SESSION:-own}
+browser_as=${BROWSER_AS:-user}
 pacing=${PACING:-fast realtime}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -74,9 +69,9 @@ with_viewer() {  # with_viewer NAME BINARY: the browser's CPU seconds into NAME.
     # orbis serves it and stays on it, rendering, until orbis has finished; SIGTERM then makes
     # it write what its processes used and close (--dump-dom would leave after the first
     # messages). It checks the page once a second, to add little of its own.
-    local session=()
-    [[ $browser_session == same ]] || session=(setsid)  # not a group leader: setsid execs, $! is the probe's
-    "${session[@]}" python3 "$root/tests/viewer/page_probe.py" "http://127.0.0.1:$port/" --until "window.orbisScene.live === false" \
+    local as_user=()  # neither forks: $! is the probe's pid
+    [[ $browser_as == root ]] || as_user=(setsid setpriv --bounding-set -sys_nice --inh-caps -sys_nice)
+    "${as_user[@]}" python3 "$root/tests/viewer/page_probe.py" "http://127.0.0.1:$port/" --until "window.orbisScene.live === false" \
       --timeout 300 --poll 1 --ready-file "$work/ready" --metrics "$work/$name.metrics" >/dev/null 2>&1 &
     reader=$!
     for _ in $(seq 300); do [[ -e $work/ready ]] && break; sleep 0.1; done
@@ -111,7 +106,7 @@ case $mode in
   realtime) pacing_args=(--realtime) ;;
   *) echo "PACING: fast or realtime, not $mode" >&2; exit 2 ;;
 esac
-echo "== pacing: $mode ($client$([[ $client != chromium ]] || echo ", browser in the $browser_session session"); load average $(cut -d' ' -f1-3 /proc/loadavg); the sequence lasts $duration s)"
+echo "== pacing: $mode ($client$([[ $client != chromium ]] || echo ", browser as $browser_as"); load average $(cut -d' ' -f1-3 /proc/loadavg); the sequence lasts $duration s)"
 printf "%-7s %11s %9s %9s %9s %8s %8s %10s\n" run extraction tracking observer "sum ms" "run s" "CPU s" "browser s"
 for kind in "${kinds[@]}"; do : >"$work/$kind.sums"; done
 for round in $(seq "$rounds"); do
