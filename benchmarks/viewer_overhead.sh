@@ -13,10 +13,10 @@
 #             drops CAP_SYS_NICE), as a browser started from the desktop beside orbis in a
 #             terminal. root: in the benchmark's session, with root's rights, under which Chromium
 #             raises its browser and GPU processes to nice -8 (no desktop browser can). Either
-#             way, on a 2-core machine shared with other jobs, tracking came out faster with the
-#             viewer open than without in most rounds (as root: medians of per-round ratios
-#             -14 % to -53 % over 5 invocations; as user -22 % over 3 rounds): runs there measure
-#             the other jobs' scheduling more than the viewer; see the README.
+#             way, on a 2-core machine shared with other jobs, tracking often came out faster with
+#             the viewer open than without (medians of per-round ratios as root -6 % to -53 % over
+#             six sets of 3-5 rounds; as user -53 % to +12 % over four sets of 5): runs there
+#             measure the other jobs' scheduling more than the viewer; see the README.
 # Runs threaded (as in real time). Per run, from report.json: medians of ORB extraction, of the
 # tracking stages ("tracking: total") and of the observer's per-frame copy ("tracking: observer",
 # only with the viewer), their sum; the CPU seconds of the whole orbis process; with Chromium,
