@@ -57,7 +57,7 @@ int viewerPort(const ArgParser& p) {
 
 int runCommand(const std::vector<std::string>& rawArgs) {
   const std::vector<std::string> args = withViewerPort(rawArgs);
-  ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic]",
+  ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic] [--realtime]",
               "Runs SLAM over a dataset sequence and writes DIR/trajectory.txt, keyframes.txt, report.json,\n"
               "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.\n"
               "kitti-raw PATH is a raw drive folder (image_00, image_01, oxts) with the calib_*.txt files beside it.");
@@ -70,6 +70,7 @@ int runCommand(const std::vector<std::string>& rawArgs) {
       .option("--sequence", "NN", "KITTI: the sequence to run when PATH holds several (sequences/NN)")
       .option("--max-frames", "N", "process at most N frames (0: all)", "0")
       .option("--dense", "FILE", "RGB-D: write a dense coloured cloud (PLY, 1 cm voxels) back-projected from the final keyframes' depth maps")
+      .flag("--realtime", "feed each frame at its timestamp (counted from the first), as a live camera would; a frame tracking is late for goes at once (default: as fast as tracking goes)")
       .flag("--deterministic", "run the stages inline in a fixed order: identical input gives an identical trajectory")
       .flag("--localize", "localisation only: track against the map without mapping")
       .option("--load-map", "FILE", "start from a saved map (same sensor, camera and vocabulary) and relocalise in it")
@@ -91,6 +92,7 @@ int runCommand(const std::vector<std::string>& rawArgs) {
   options.outDir = p.get("--out");
   createOutputFolder(options.outDir);
   options.deterministic = p.has("--deterministic");
+  options.realtime = p.has("--realtime");
   options.stats = p.has("--stats");
   options.localisationOnly = p.has("--localize");
   options.loopClosing = !p.has("--no-loop");

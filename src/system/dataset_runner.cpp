@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <thread>
 
 #include "orbis/eval/metrics.hpp"
 #include "orbis/io/dense_cloud.hpp"
@@ -148,6 +149,32 @@ Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& or
   else return Slam<Sensor>(camera, orb, std::move(vocabulary), options);
 }
 
+// RunOptions::realtime: holds each frame back until its timestamp, counted from the first frame's,
+// is due on the steady clock; a frame already due (tracking is behind) goes at once.
+class FramePacer {
+ public:
+  explicit FramePacer(bool enabled) : enabled_(enabled) {}
+  void waitUntilDue(double timestamp) {
+    if (!enabled_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!started_) {
+      started_ = true;
+      firstTimestamp_ = timestamp;
+      firstFed_ = now;
+      return;
+    }
+    const auto due = firstFed_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                     std::chrono::duration<double>(timestamp - firstTimestamp_));
+    if (due > now) std::this_thread::sleep_until(due);
+  }
+
+ private:
+  bool enabled_;
+  bool started_ = false;
+  double firstTimestamp_ = 0;
+  std::chrono::steady_clock::time_point firstFed_;
+};
+
 template <class Sensor>
 void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<double>& lens, const OrbParams& orb,
              double fps, DatasetReader& dataset, const RunOptions& options, RunReport& report) {
@@ -180,6 +207,7 @@ void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<doubl
   if (options.denseCloud && !Sensor::kDepthFromSensor)
     report.warnings.push_back("--dense needs an RGB-D sequence: no dense cloud written");
   std::exception_ptr failure;
+  FramePacer pacer(options.realtime);
   try {
     for (std::size_t i = 0; i < n; ++i) {
       DatasetFrame frame;
@@ -202,6 +230,7 @@ void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<doubl
       }
       for (const auto& w : frame.warnings) report.warnings.push_back("frame " + std::to_string(i) + ": " + w);
       lastTimestamp = frame.timestamp;
+      pacer.waitUntilDue(frame.timestamp);  // after reading: loading the images is not the camera's delay
       const TrackResult r = slam.track(input);
       if constexpr (Sensor::kDepthFromSensor) {
         if (options.denseCloud && r.newKeyFrame) keyFrameImages[frame.timestamp] = {input.depth, input.image};

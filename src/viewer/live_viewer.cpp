@@ -11,6 +11,10 @@
 #include <optional>
 #include <thread>
 #include <time.h>
+#ifdef __linux__
+#include <sys/resource.h>
+#include <unistd.h>
+#endif
 #include <unordered_set>
 
 #include "orbis/util/error.hpp"
@@ -192,6 +196,19 @@ void LiveViewer::Impl::streamEvents(httplib::Response& response) {
       [this](bool) { --clients; });
 }
 
+// The viewer is best-effort work on the machine that runs SLAM: its threads take the lowest
+// priority (nice 19), so where tracking and mapping keep the cores busy they get only what SLAM
+// leaves. Linux keeps a nice value per thread, and a thread's children start with it: called
+// first on the server's thread, it covers the workers cpp-httplib starts there. Best effort: a
+// refusal leaves the thread as it was.
+namespace {
+void yieldToSlam() {
+#ifdef __linux__
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+#endif
+}
+}  // namespace
+
 double threadCpuSeconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
@@ -266,8 +283,14 @@ LiveViewer::LiveViewer(ViewerOptions options) : impl_(std::make_unique<Impl>()) 
   });
   if (!impl_->server.bind_to_port(impl_->options.host.c_str(), impl_->options.port))
     throw Error("viewer", "", "cannot listen on " + url() + " (port in use?)");
-  impl_->serverThread = std::thread([this] { impl_->server.listen_after_bind(); });
-  impl_->publisherThread = std::thread([this] { impl_->publishLoop(); });
+  impl_->serverThread = std::thread([this] {
+    yieldToSlam();
+    impl_->server.listen_after_bind();
+  });
+  impl_->publisherThread = std::thread([this] {
+    yieldToSlam();
+    impl_->publishLoop();
+  });
 }
 
 LiveViewer::~LiveViewer() {

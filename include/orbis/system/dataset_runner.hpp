@@ -11,6 +11,11 @@
 // later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
 // else from the dataset's own calibration. RunOptions::observer, when set, sees every frame and
 // takes map snapshots while the run lasts, and gets the final map after shutdown.
+// RunOptions::realtime feeds the frames at the rate they were recorded, as a live camera would:
+// each frame no earlier than its timestamp's offset from the first frame's (on the steady clock,
+// from when the first was fed); a frame tracking is already late for is fed at once, never
+// skipped, and the run does not slow down to catch up. Without it, frames are fed as fast as
+// tracking takes them.
 #pragma once
 
 #include <filesystem>
@@ -34,6 +39,7 @@ struct RunOptions {
   std::optional<std::filesystem::path> denseCloud;  // RGB-D: back-projected keyframe depth maps
   std::size_t maxFrames = 0;                        // 0: all
   bool progress = true;
+  bool realtime = false;  // feed each frame at its timestamp (relative to the first), not as fast as tracking goes
   std::optional<std::filesystem::path> loadMap;  // map file to localise in (io/map_file.hpp)
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
   SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned

@@ -9,10 +9,12 @@
 // frame is encoded while no browser has been sent the previous one) and takes a map snapshot at
 // mapRateHz, and only while a browser is connected. A browser is sent the whole map when it
 // connects, then what changed since the previous map message (src/viewer/map_delta.hpp); one that
-// lags further behind than the recent changes kept is sent the whole map again. Each browser gets the newest frame: a
-// slow or vanished browser misses updates, never delays tracking. detach() or show() publish a
-// final map, which the page keeps showing until the viewer is destroyed. The constructor throws
-// orbis::Error when the port cannot be bound; the destructor stops the server and threads.
+// lags further behind than the recent changes kept is sent the whole map again. Each browser gets
+// the newest frame: a slow or vanished browser misses updates, never delays tracking. The viewer's
+// threads (publisher, server) run at the lowest priority (nice 19 on Linux): best-effort work
+// yields the cores to SLAM. detach() or show() publish a final map, which the page keeps showing
+// until the viewer is destroyed. The constructor throws orbis::Error when the port cannot be
+// bound; the destructor stops the server and threads.
 #pragma once
 
 #include <memory>

@@ -39,11 +39,13 @@ function drawImage(frame) {
 }
 
 function paintImage(frame, img) {  // the counts beside the picture are of the frame it shows
+  // The canvas's size is read before any text is written: reading a size after a change to the
+  // page forces the browser to lay the page out again at once (then again at the next drawing).
+  const image = ui('image');
+  const width = Math.max(1, Math.round(image.clientWidth || 320));
   const counts = [0, 0, 0, 0];
   for (let i = 2; i < frame.keypoints.length; i += 3) counts[frame.keypoints[i]]++;
   setText('matches', `${counts[1]} / ${counts[2]} / ${counts[3]}`);
-  const image = ui('image');
-  const width = Math.max(1, Math.round(image.clientWidth || 320));
   const height = frame.width > 0 ? Math.max(1, Math.round(width * frame.height / frame.width)) : image.height;
   if (image.width !== width || image.height !== height) {
     image.width = width;
@@ -76,7 +78,7 @@ function paintImage(frame, img) {  // the counts beside the picture are of the f
   showSceneState();
 }
 
-function showSceneState() { ui('scene-state').textContent = JSON.stringify(window.orbisScene); }
+function showSceneState() { setText('scene-state', JSON.stringify(window.orbisScene)); }
 
 let loopsAnnounced = 0;
 function announceLoops(closures) {

@@ -22,9 +22,9 @@ const LAYERS = {
 };
 
 window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, live: null, webgl: false,
-                      fullMaps: 0, mapDeltas: 0 };
+                      fullMaps: 0, mapDeltas: 0, renders: 0 };
 const store = new SceneStore();
-const view = { paused: false, frame: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
+const view = { paused: false, frame: null, frameText: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
                mode: 'follow', cameraCentre: null, userMoved: false, recolour: false, pointKey: null };
 
 // ---- three.js scene ------------------------------------------------------------------------
@@ -60,8 +60,20 @@ world.updateMatrixWorld();
 const camera = new THREE.PerspectiveCamera(55, 1, 0.005, 500);
 camera.position.set(0, 2, -3);
 const controls = renderer ? new THREE.OrbitControls(camera, renderer.domElement) : null;
+// The page's own camera moves (following the camera, fitting the map) are drawn by the draw that
+// makes them: OrbitControls.update() announces them as a change, which must not draw again.
+let movingCameraItself = false;
+function moveCameraItself(move) {
+  movingCameraItself = true;
+  try {
+    move();
+    controls.update();
+  } finally {
+    movingCameraItself = false;
+  }
+}
 if (controls) {
-  controls.addEventListener('change', () => interactiveDraw());
+  controls.addEventListener('change', () => { if (!movingCameraItself) interactiveDraw(); });
   controls.addEventListener('start', () => { view.userMoved = true; });  // the user's drag or wheel only
 }
 const layers = {};
@@ -231,23 +243,25 @@ function fitView(top) {
   if (box.isEmpty()) return;
   const centre = box.getCenter(new THREE.Vector3());
   const radius = Math.max(0.5, box.getSize(new THREE.Vector3()).length());
-  controls.target.copy(centre);
-  if (top) {
-    camera.up.set(0, 0, -1);
-    camera.position.set(centre.x, centre.y + radius * 1.3, centre.z + 0.001);
-  } else {
-    camera.up.set(0, 1, 0);
-    camera.position.set(centre.x - radius * 0.6, centre.y + radius * 0.7, centre.z - radius * 0.9);
-  }
-  controls.update();
+  moveCameraItself(() => {
+    controls.target.copy(centre);
+    if (top) {
+      camera.up.set(0, 0, -1);
+      camera.position.set(centre.x, centre.y + radius * 1.3, centre.z + 0.001);
+    } else {
+      camera.up.set(0, 1, 0);
+      camera.position.set(centre.x - radius * 0.6, centre.y + radius * 0.7, centre.z - radius * 0.9);
+    }
+  });
 }
 
 function followCamera() {
   if (view.mode !== 'follow' || !view.cameraCentre || !controls) return;
   const shift = view.cameraCentre.clone().sub(controls.target);
-  controls.target.add(shift);
-  camera.position.add(shift);
-  controls.update();
+  moveCameraItself(() => {
+    controls.target.add(shift);
+    camera.position.add(shift);
+  });
 }
 
 // ---- drawing -----------------------------------------------------------------------------------
@@ -289,8 +303,19 @@ const drawing = {
             period: 1000 / (software ? SOFTWARE_SCENE_DRAWS_PER_SECOND : PANEL_DRAWS_PER_SECOND) },
 };
 
+// The newest frame message is parsed when it is drawn, not when it arrives: a page in a hidden
+// tab (the browser stops its drawing) then spends nothing on the frames it is sent.
+function newestFrame() {
+  if (view.frameText !== null) {
+    view.frame = JSON.parse(view.frameText);
+    view.frameText = null;
+  }
+  return view.frame;
+}
+
 function draw() {
   drawing.pending = false;
+  newestFrame();
   const now = performance.now();
   const { panel, view3d } = drawing;
   let render = drawing.interactive;
@@ -311,7 +336,10 @@ function draw() {
     followCamera();
     render = true;
   }
-  if (renderer && render) renderer.render(scene, camera);
+  if (renderer && render) {
+    renderer.render(scene, camera);
+    window.orbisScene.renders++;
+  }
   scheduleStreamed();
 }
 
@@ -421,7 +449,7 @@ function connect() {
   const events = new EventSource('events');
   events.onopen = () => store.reset();
   events.addEventListener('frame', (e) => {
-    view.frame = JSON.parse(e.data);
+    view.frameText = e.data;
     streamed(true, true);  // the panel, and the current camera in 3-D
   });
   events.addEventListener('map', (e) => {
