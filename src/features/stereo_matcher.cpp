@@ -11,15 +11,25 @@
 namespace orbis {
 namespace {
 
-// Sum of absolute differences of two (2h+1)^2 patches, each taken relative to its centre
-// pixel so that a brightness offset between the cameras does not count.
-int centredSad(const std::uint8_t* a, int stepA, const std::uint8_t* b, int stepB, int h) {
-  const int ca = a[0], cb = b[0];
+constexpr int kPatchArea = (2 * StereoMatcher::kPatchHalf + 1) * (2 * StereoMatcher::kPatchHalf + 1);
+
+// Sum of the (2h+1) intensities of column x of rows -h..h around row pointer p.
+int columnSum(const std::uint8_t* p, int step, int x) {
+  int sum = 0;
+  for (int dy = -StereoMatcher::kPatchHalf; dy <= StereoMatcher::kPatchHalf; ++dy) sum += p[dy * step + x];
+  return sum;
+}
+
+// Sum of absolute differences of two patches, each taken relative to its own mean so that a
+// brightness offset between the cameras does not count; in units of 1/kPatchArea grey levels,
+// which keeps it exact in integers. offset = kPatchArea x (mean of a - mean of b).
+int zeroMeanSad(const std::uint8_t* a, int stepA, const std::uint8_t* b, int stepB, int offset) {
+  constexpr int h = StereoMatcher::kPatchHalf;
   int sum = 0;
   for (int dy = -h; dy <= h; ++dy) {
     const std::uint8_t* ra = a + dy * stepA;
     const std::uint8_t* rb = b + dy * stepB;
-    for (int dx = -h; dx <= h; ++dx) sum += std::abs((ra[dx] - ca) - (rb[dx] - cb));
+    for (int dx = -h; dx <= h; ++dx) sum += std::abs(kPatchArea * (ra[dx] - rb[dx]) - offset);
   }
   return sum;
 }
@@ -96,10 +106,19 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
     const std::uint8_t* patchL = imL.ptr<std::uint8_t>(vL) + uL;
     const std::uint8_t* rowR = imR.ptr<std::uint8_t>(vL);
     const int stepL = static_cast<int>(imL.step), stepR = static_cast<int>(imR.step);
+    // Patch sums from column sums: the left patch's once, the right one's slid along the row.
+    int sumL = 0;
+    for (int dx = -kPatchHalf; dx <= kPatchHalf; ++dx) sumL += columnSum(patchL, stepL, dx);
+    int columnsR[2 * (kSlide + kPatchHalf) + 1];
+    for (int x = -kSlide - kPatchHalf; x <= kSlide + kPatchHalf; ++x)
+      columnsR[x + kSlide + kPatchHalf] = columnSum(rowR + uR0, stepR, x);
+    int sumR = 0;
+    for (int x = 0; x < 2 * kPatchHalf + 1; ++x) sumR += columnsR[x];
     int costs[2 * kSlide + 1];
     int bestCost = INT_MAX, bestShift = 0;
     for (int s = -kSlide; s <= kSlide; ++s) {
-      const int c = centredSad(patchL, stepL, rowR + uR0 + s, stepR, kPatchHalf);
+      if (s > -kSlide) sumR += columnsR[s + kSlide + 2 * kPatchHalf] - columnsR[s + kSlide - 1];
+      const int c = zeroMeanSad(patchL, stepL, rowR + uR0 + s, stepR, sumL - sumR);
       costs[s + kSlide] = c;
       if (c < bestCost) {
         bestCost = c;

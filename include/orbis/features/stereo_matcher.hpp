@@ -4,7 +4,7 @@
 // the right keypoint's level) with octave within one of the left's and disparity in
 // [0, bf / minDepth] are candidates; the one at the smallest Hamming distance, if below
 // kMaxDescriptorDistance, is refined by sliding an 11x11 patch (+-5 px, on the left keypoint's
-// pyramid level, each patch minus its centre intensity, sum of absolute differences) and a
+// pyramid level, each patch minus its own mean intensity, sum of absolute differences) and a
 // parabola through the three best costs; matches at the edge of the slide or with a parabola
 // offset beyond one pixel are dropped, and finally those whose patch cost exceeds
 // 1.5 x 1.4 x the median cost. Output per left keypoint: uRight (level-0 pixels) and

@@ -86,6 +86,9 @@ class Relocaliser {
   const RelocalisationStats& stats() const { return stats_; }
 
  private:
+  // Covisible keyframes of a candidate whose points the guided search also projects (as many as
+  // the tracker's local map takes from each of its keyframes).
+  static constexpr std::size_t kCovisiblesSearched = 10;
   // Pose and matches of `frame` from one candidate's BoW matches; false when rejected.
   bool tryCandidate(FrameT& frame, const KeyFrame& kf, const std::vector<MapPoint*>& bowMatches,
                     std::mt19937_64& rng) const;

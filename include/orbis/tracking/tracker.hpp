@@ -125,6 +125,9 @@ class Tracker {
   bool trackReferenceKeyFrame();
   // Projects the last frame's matches through `motion` (current from last) and optimises.
   bool trackWithMotionModel(const SE3d& motion);
+  // Frames a relocalisation must track the local map for (the relocalised one included) before
+  // a keyframe may be made from its pose; see needNewKeyFrame.
+  static constexpr std::uint64_t kFramesToConfirmRelocalisation = 3;
   // The current frame is fewer than n frames after the last relocalisation (if any).
   bool withinFramesOfRelocalisation(std::uint64_t n) const {
     return lastRelocalisedFrame_ && current_.index < *lastRelocalisedFrame_ + n;

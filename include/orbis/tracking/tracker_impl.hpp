@@ -416,8 +416,15 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
   if (mapper_ && mapper_->isStoppedOrStopping()) return false;
   const std::size_t keyFrames = map_.keyFrameCount();
   const auto maxFrames = static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
-  if (withinFramesOfRelocalisation(maxFrames) && keyFrames > maxFrames)
-    return false;
+  // ORB-SLAM2 makes no keyframe for maxFrames (one second) after a relocalisation once the map
+  // has more than maxFrames keyframes, so that a wrong relocalisation cannot spread into the map.
+  // But a camera that relocalised at the edge of the map and moves on then runs off it with no
+  // way to extend it: on the rendered loop, relocalised 10 frames after a black gap, inliers fell
+  // 281 -> 36 in 14 frames with keyframes wanted from the 7th on, and the sequence ended lost.
+  // The pose is confirmed sooner: every frame in that second must track the local map with 50
+  // inliers or tracking is lost again, and from the third frame on its prediction comes from the
+  // velocity between two such frames. So keyframes wait only for that.
+  if (withinFramesOfRelocalisation(kFramesToConfirmRelocalisation) && keyFrames > maxFrames) return false;
   const int minObservations = keyFrames <= 2 ? 2 : 3;
   const int referenceMatches = reference_->trackedPoints(minObservations);
   bool mapperIdle = mapper_ ? mapper_->acceptsKeyFrames() : true;
