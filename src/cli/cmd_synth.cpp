@@ -48,6 +48,10 @@ int runSynth(const std::vector<std::string>& args) {
       .option("--blur", "N", "motion blur: sub-frames averaged per frame (1 = none)", "1")
       .option("--black", "START:COUNT", "black out COUNT frames from frame START (relocalisation tests)")
       .option("--flat", "START:COUNT", "textureless frames (uniform grey plus noise) from frame START")
+      .option("--scene", "room|corridor",
+              "room: the 11 m loop in a room looking outwards; corridor: a 27 m loop round a central block "
+              "looking ahead (the start leaves the view for most of the loop)",
+              "room")
       .option("--motion", "loop|rotation|static", "camera motion: the loop, a pure rotation in place, or none", "loop")
       .option("--seed", "S", "seed of the scene, textures and noise", "1")
       .option("--supersample", "N", "rays per pixel along each axis (antialiasing)", "2")
@@ -90,6 +94,9 @@ int runSynth(const std::vector<std::string>& args) {
   if (motion == "rotation") o.path.motion = synth::PathMotion::PureRotation;
   else if (motion == "static") o.path.motion = synth::PathMotion::Static;
   else if (motion != "loop") throw Error("argument --motion", "", "expected loop, rotation or static, not '" + motion + "'");
+  const std::string scene = p.get("--scene");
+  if (scene == "corridor") synth::applyScenePreset(synth::ScenePreset::Corridor, o.room, o.path);
+  else if (scene != "room") throw Error("argument --scene", "", "expected room or corridor, not '" + scene + "'");
   const synth::SynthLayout layout = synth::parseSynthLayout(p.get("--layout"), "argument --layout");
   const bool json = p.has("--json");
 
@@ -117,6 +124,7 @@ int runSynth(const std::vector<std::string>& args) {
         .field("fx", o.fx)
         .field("baseline", o.baseline)
         .field("seed", static_cast<std::int64_t>(o.seed))
+        .field("scene", scene)
         .field("rects", sequence.scene().rects().size())
         .field("ground_truth", r.groundTruth.string())
         .field("settings", r.settings.string())

@@ -154,6 +154,13 @@ Scene makeRoomScene(const RoomParams& params, std::uint64_t seed) {
       break;
     }
   }
+  if (params.pillarHalf.x() > 0.0 && params.pillarHalf.y() > 0.0) {
+    // A hair below the ceiling, so its top and the ceiling never share a plane.
+    const Eigen::Vector2d& half = params.pillarHalf;
+    scene.addBox(Eigen::Vector3d(centre.x() - half.x(), centre.y() - half.y(), lo.z()),
+                 Eigen::Vector3d(centre.x() + half.x(), centre.y() + half.y(), hi.z() - 1e-3), params.texelSize,
+                 mixSeed(seed, 3000));
+  }
   return scene;
 }
 

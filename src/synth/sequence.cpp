@@ -17,6 +17,22 @@ void require(bool ok, const std::string& key, const std::string& what) {
 
 }  // namespace
 
+void applyScenePreset(ScenePreset preset, RoomParams& room, LoopTrajectoryParams& path) {
+  room = RoomParams{};
+  path = LoopTrajectoryParams{path.motion};
+  if (preset == ScenePreset::Room) return;
+  room.min = {-7.0, -5.5, 0.0};
+  room.max = {7.0, 5.5, 3.0};
+  room.pillarHalf = {3.2, 2.0};
+  // The path's ellipse passes 0.9 m outside the block's corners and 1.8-2 m inside the walls;
+  // boxes stand between it and the walls.
+  path.radiusX = 5.0;
+  path.radiusY = 3.7;
+  room.freeRadiusX = 5.4;
+  room.freeRadiusY = 4.1;
+  path.yawOffset = 0.0;  // looking ahead along the corridor
+}
+
 SyntheticSequence::SyntheticSequence(const SynthOptions& options)
     : options_(options), renderer_(RenderOptions{options.supersample, 0.0, options.threads}) {
   require(options.frames > 0, "frames", "must be positive");

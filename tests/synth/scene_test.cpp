@@ -1,12 +1,16 @@
 // The standard room: closed, with every box placed inside it, clear of the camera path, and at
-// a spread of distances; rectangles and texture coordinates map as the header says.
+// a spread of distances; rectangles and texture coordinates map as the header says. The corridor
+// preset: its loop runs clear of the central block, the boxes and the walls, and the block hides
+// the start from half way round.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "orbis/synth/loop_trajectory.hpp"
 #include "orbis/synth/scene.hpp"
+#include "orbis/synth/sequence.hpp"
 
 namespace orbis::synth {
 namespace {
@@ -68,6 +72,50 @@ TEST(SynthScene, RaysFromInsideTheRoomAlwaysHitAndTexelsMapToPoints) {
   const auto fromOutside = scene.intersect(Eigen::Vector3d(-20.0, 0.0, 1.0), Eigen::Vector3d(1.0, 0.0, 0.0));
   ASSERT_TRUE(fromOutside.has_value());
   EXPECT_GT(fromOutside->distance, 15.0 + 1e-6);
+}
+
+TEST(SynthScene, CorridorLoopRunsClearOfBlockBoxesAndWallsAndTheBlockHidesTheStart) {
+  RoomParams room;
+  LoopTrajectoryParams path;
+  applyScenePreset(ScenePreset::Corridor, room, path);
+  for (std::uint64_t seed : {1u, 41u, 42u, 43u}) {
+    const Scene scene = makeRoomScene(room, seed);
+    // After the six walls every box, the central block last, has five faces.
+    ASSERT_EQ((scene.rects().size() - 6) % 5, 0u);
+    std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes;
+    for (std::size_t first = 6; first < scene.rects().size(); first += 5) {
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = Eigen::Vector3d::Constant(-1e9);
+      for (std::size_t f = first; f < first + 5; ++f) {
+        const SceneRect& r = scene.rects()[f];
+        for (int corner = 0; corner < 2; ++corner) {
+          Eigen::Vector3d p;
+          p[r.axis] = r.offset;
+          p[(r.axis + 1) % 3] = corner ? r.hi[0] : r.lo[0];
+          p[(r.axis + 2) % 3] = corner ? r.hi[1] : r.lo[1];
+          lo = lo.cwiseMin(p);
+          hi = hi.cwiseMax(p);
+        }
+      }
+      boxes.emplace_back(lo, hi);
+    }
+    ASSERT_GE(boxes.size(), 2u) << "seed " << seed << ": the block and some boxes";
+    EXPECT_NEAR(boxes.back().first.x(), -room.pillarHalf.x(), 1e-9) << "the block comes last";
+    for (int i = 0; i < 360; ++i) {
+      const Eigen::Vector3d c = loopPose(path, i / 360.0).translation();
+      EXPECT_TRUE(((c - room.min).head<2>().array() > 1.0).all() && ((room.max - c).head<2>().array() > 1.0).all())
+          << "a metre from the walls at phase " << i / 360.0;
+      for (const auto& [lo, hi] : boxes) {
+        const Eigen::Vector3d outside = (lo - c).cwiseMax(c - hi).cwiseMax(Eigen::Vector3d::Zero());
+        ASSERT_GT(outside.norm(), 0.5) << "seed " << seed << " phase " << i / 360.0;
+      }
+    }
+  }
+  // Half way round, the block stands between the camera and where it started.
+  const Scene scene = makeRoomScene(room, 1);
+  const Eigen::Vector3d start = loopPose(path, 0.0).translation(), half = loopPose(path, 0.5).translation();
+  const auto hit = scene.intersect(half, (start - half).normalized());
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_LT(hit->distance, (start - half).norm() - 1.0);
 }
 
 }  // namespace

@@ -72,6 +72,10 @@ struct RoomParams {
   int boxes = 8;                         // boxes around the centre, at several depths
   double freeRadiusX = 2.9;              // no box intrudes into this ellipse around the centre
   double freeRadiusY = 2.3;              // (the camera path of LoopTrajectoryParams lies inside it)
+  // Half extents of a block standing floor to ceiling at the room's centre, inside the free
+  // ellipse (zero: none). The camera path then runs round it as a corridor loop: the block hides
+  // the far side of the room, so a place leaves the view until the camera comes back to it.
+  Eigen::Vector2d pillarHalf{0.0, 0.0};
 };
 
 Scene makeRoomScene(const RoomParams& params, std::uint64_t seed);

@@ -26,6 +26,16 @@
 
 namespace orbis::synth {
 
+// The scene and path presets `orbis synth --scene` offers. Room: the standard room (defaults of
+// RoomParams and LoopTrajectoryParams), its 11 m loop looking outwards at walls 2-3 m away, each
+// wall in view for a large part of the loop. Corridor: a 14 x 11 m floor round a 6.4 x 4 m
+// central block, a 27 m loop between them with the camera looking ahead along the corridor, as
+// real loop sequences are walked or driven: what the camera sees at the start is hidden behind
+// the block for most of the loop, so the drift of a monocular map builds up as in a real loop
+// before it comes back.
+enum class ScenePreset { Room, Corridor };
+void applyScenePreset(ScenePreset preset, RoomParams& room, LoopTrajectoryParams& path);
+
 struct SynthOptions {
   int frames = 300;
   int extraFrames = 0;  // written past the loop's end: the path repeats, so the camera goes on over
