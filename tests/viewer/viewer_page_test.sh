@@ -27,7 +27,10 @@ fi
 # The first page is open before SLAM starts (page_probe --ready-file: the browser starts, then
 # loads the page as soon as orbis serves it), so it sees the whole map once, then only changes
 # (map_delta.hpp). Its screenshot is taken once it shows the loop closure, live; it stays to
-# the end. A free port: orbis refuses a busy one at once.
+# the end. The run is paced at the sequence's frame rate (--realtime), as a camera feeds it: the
+# viewer's threads run at the lowest priority and, with frames fed as fast as tracking goes on a
+# machine the other tests keep busy, may get no time until SLAM has finished. A free port: orbis
+# refuses a busy one at once.
 probe=$(dirname "$0")/page_probe.py
 pid="" first=""
 for port in 18751 18752 18753 18754 18755; do
@@ -39,7 +42,7 @@ for port in 18751 18752 18753 18754 18755; do
   first=$!
   for _ in $(seq 300); do [[ -e $work/ready ]] && break; sleep 0.1; done
   "$orbis" run tum "$work/synth" --settings "$work/synth/settings.yaml" --out "$work/out" \
-    --viewer "$port" --viewer-wait >"$work/run.log" 2>&1 &
+    --realtime --viewer "$port" --viewer-wait >"$work/run.log" 2>&1 &
   pid=$!
   sleep 0.5
   if kill -0 "$pid" 2>/dev/null; then break; fi
