@@ -131,20 +131,29 @@ TEST(MonocularSlam, SyntheticLoopInitialisesEarlyAndTracksUnderOnePercentOfPath)
   EXPECT_LT(ate.stats.rmse, 0.01 * length);
 }
 
+// The first `count` frames of the 320x240 loop (seed 41) with image noise sigma 4.
+struct LowResolutionLoop {
+  synth::SynthOptions options;
+  std::vector<synth::SynthFrame> frames;
+};
+LowResolutionLoop lowResolutionNoisyLoop(int count) {
+  LowResolutionLoop loop{monoOptions(300, 41), {}};
+  loop.options.width = 320;
+  loop.options.height = 240;
+  loop.options.fx = 250;
+  loop.options.noiseSigma = 4;
+  synth::SyntheticSequence seq(loop.options);
+  for (int i = 0; i < count; ++i) loop.frames.push_back(seq.render(i, false, false));
+  return loop;
+}
+
 // At 320x240 with noise the finest level keeps few repeatable corners: the windowed matches
 // fall under 100 within 5-8 frames of a reference, and under so little parallax H and F explain
 // the matches alike (R_H 0.46-0.49), so H won by the paper's 0.45 and its two-fold plane
 // ambiguity refused every attempt (seed 41: initialised at frame 66). Falling back to F's
 // reconstruction on such a narrow, ambiguous H win (two_view.hpp) initialises it early.
 TEST(MonocularSlam, LowResolutionLoopInitialisesWithinThirtyFrames) {
-  synth::SynthOptions options = monoOptions(300, 41);
-  options.width = 320;
-  options.height = 240;
-  options.fx = 250;
-  options.noiseSigma = 4;
-  synth::SyntheticSequence seq(options);
-  std::vector<synth::SynthFrame> frames;
-  for (int i = 0; i < 30; ++i) frames.push_back(seq.render(i, false, false));
+  const auto [options, frames] = lowResolutionNoisyLoop(30);
   const MonoRun run = runMono(options, frames);
   std::cout << "[mono] 320x240 loop, seed 41: initialised at frame "
             << (run.stats.initialisedAtFrame ? std::to_string(*run.stats.initialisedAtFrame) : "never") << " ("
@@ -161,14 +170,7 @@ TEST(MonocularSlam, LowResolutionLoopInitialisesWithinThirtyFrames) {
 // frame rate of 1000 Hz leaves tracking no time in the frame period, as there; the scale of the
 // last 30 frames must stay that of the first 30.
 TEST(MonocularSlam, ThreadedTrackingWithNoTimeToSpareKeepsTheScale) {
-  synth::SynthOptions options = monoOptions(300, 41);
-  options.width = 320;
-  options.height = 240;
-  options.fx = 250;
-  options.noiseSigma = 4;
-  synth::SyntheticSequence seq(options);
-  std::vector<synth::SynthFrame> frames;
-  for (int i = 0; i < 90; ++i) frames.push_back(seq.render(i, false, false));
+  const auto [options, frames] = lowResolutionNoisyLoop(90);
   const MonoRun run = runMono(options, frames, {.threaded = true, .fps = 1000.0});
   ASSERT_TRUE(run.stats.initialisedAtFrame.has_value()) << waits(run.stats);
   const std::size_t start = *run.stats.initialisedAtFrame;
