@@ -184,6 +184,7 @@ void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<doubl
   slamOptions.localisationOnly = options.localisationOnly;
   slamOptions.loopClosing = options.loopClosing;
   slamOptions.fps = fps;
+  slamOptions.liveCamera = options.realtime;
   Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, vocabulary, slamOptions);
   slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {

@@ -65,6 +65,8 @@ class LocalMapper final : public LocalMappingControl {
   void runUntilIdle();
   // Threaded mode: block until the queue is empty and the worker is idle.
   void waitUntilIdle();
+  // Threaded mode: the same for at most `budget`; true when idle.
+  bool waitUntilIdleFor(std::chrono::steady_clock::duration budget);
   void shutdown();
 
   void setKeyFrameSink(std::function<void(KeyFrame*)> sink) { sink_ = std::move(sink); }

@@ -114,6 +114,11 @@ void LocalMapper<Sensor>::waitUntilIdle() {
 }
 
 template <SensorConfiguration Sensor>
+bool LocalMapper<Sensor>::waitUntilIdleFor(std::chrono::steady_clock::duration budget) {
+  return worker_.waitUntilIdleFor(budget);
+}
+
+template <SensorConfiguration Sensor>
 bool LocalMapper<Sensor>::processOne() {
   const std::optional<KeyFrame*> next = worker_.pop();
   if (!next) return false;

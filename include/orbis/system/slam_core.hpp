@@ -36,6 +36,11 @@ struct SlamOptions {
   bool localisationOnly = false;  // tracking only, against the existing map (§III-F)
   bool loopClosing = true;
   double fps = 30;                // frame rate: the keyframe rule's "max frames" (ORB-SLAM2)
+  // Frames come from a live camera at fps (orbis run --realtime): threaded monocular tracking
+  // then waits for mapping after a keyframe only for what is left of the frame period, so it
+  // keeps the camera's rate; otherwise (frames fed as fast as tracking takes them) it waits
+  // until mapping is idle, which costs wall time but no frames.
+  bool liveCamera = false;
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
 };
 
