@@ -3,7 +3,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -23,6 +25,14 @@ inline std::optional<std::filesystem::path> dataset(const std::string& name) {
 }
 
 inline std::filesystem::path sourceDir() { return ORBIS_SOURCE_DIR; }
+
+// A file's whole content, byte for byte (empty when it cannot be read): outputs compared whole.
+inline std::string fileBytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
 
 }  // namespace orbis::test
 

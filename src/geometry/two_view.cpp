@@ -164,7 +164,9 @@ std::optional<ChosenModel> estimateModel(std::span<const TwoViewMatch> matches, 
   chosen.homographyRatio = homography.score.score / scoreSum;
   const bool useH = chosen.homographyRatio > options.homographyRatioThreshold;
   chosen.model = useH ? TwoViewModel::Homography : TwoViewModel::Fundamental;
-  if (useH && chosen.homographyRatio <= options.fundamentalFallbackRatio) chosen.fundamentalFallback = fundamental;
+  // H's win leaves F's fit unused but for this fallback: moved, not copied.
+  if (useH && chosen.homographyRatio <= options.fundamentalFallbackRatio)
+    chosen.fundamentalFallback = std::move(fundamental);
   chosen.fit = std::move(useH ? homography : fundamental);
   if (options.refitOnInliers) {
     if (useH) refitOnInliers(chosen.fit, fitH, scoreH);

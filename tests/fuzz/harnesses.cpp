@@ -21,6 +21,7 @@
 #include "orbis/io/settings.hpp"
 #include "orbis/io/trajectory.hpp"
 #include "orbis/util/error.hpp"
+#include "../map_file_bytes.hpp"
 
 namespace orbis::fuzz {
 namespace {
@@ -159,18 +160,12 @@ void vocabularyBinaryResealed(const std::uint8_t* data, std::size_t size) {
   bow::OrbVocabulary::load(writeFile("vocabulary_resealed.bin", bytes.data(), bytes.size()));
 }
 
-// A map file with its declared size and checksum trailer recomputed (a map file's first 16 bytes are
-// magic, version and sensor; bytes 16..24 its size): without that, nearly every mutation stops at
-// the checksum and the structure checks behind it would never be fuzzed. The file is loaded
-// against its own header, as `orbis view` does, so every field is reached.
+// A map file with its declared size and checksum trailer recomputed (../map_file_bytes.hpp), so
+// mutations reach the structure checks behind the checksum. The file is loaded against its own
+// header, as `orbis view` does, so every field is reached.
 void mapFile(const std::uint8_t* data, std::size_t size) {
   std::vector<std::uint8_t> bytes(data, data + size);
-  if (bytes.size() >= 160) {
-    const std::uint64_t declared = bytes.size();
-    std::memcpy(bytes.data() + 16, &declared, sizeof declared);
-    const std::uint64_t sum = bow::checksum64(bytes.data(), bytes.size() - 8);
-    std::memcpy(bytes.data() + bytes.size() - 8, &sum, sizeof sum);
-  }
+  test::resealMapFile(bytes);
   const fs::path file = writeFile("orbis.map", bytes.data(), bytes.size());
   const MapFileInfo info = readMapFileInfo(file);
   Map map;

@@ -25,6 +25,7 @@
 #include "orbis/bow/vocabulary_training.hpp"
 #include "orbis/io/map_file.hpp"
 #include "orbis/util/error.hpp"
+#include "map_file_bytes.hpp"
 
 namespace {
 
@@ -110,13 +111,8 @@ void writeBytes(const fs::path& f, const Bytes& b) {
 
 std::uint64_t checksumOf(const Bytes& b, std::size_t end) { return bow::checksum64(b.data(), end); }
 
-// The map format: total size at byte 16, checksum of everything before it in the last 8 bytes.
 Bytes resealMap(Bytes b) {
-  if (b.size() < 160) return b;
-  const std::uint64_t size = b.size();
-  std::memcpy(b.data() + 16, &size, sizeof size);
-  const std::uint64_t sum = checksumOf(b, b.size() - 8);
-  std::memcpy(b.data() + b.size() - 8, &sum, sizeof sum);
+  test::resealMapFile(b);
   return b;
 }
 

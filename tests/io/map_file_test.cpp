@@ -9,10 +9,10 @@
 
 #include <unistd.h>
 
-#include "orbis/bow/vocabulary_file.hpp"
 #include "orbis/bow/vocabulary_training.hpp"
 #include "orbis/io/map_file.hpp"
 #include "orbis/util/error.hpp"
+#include "map_file_bytes.hpp"
 
 namespace {
 
@@ -297,17 +297,10 @@ TEST(MapFile, InfoReadsTheHeaderAndChecksTheFile) {
 
 namespace {
 
-// Where the header's fields sit (io/map_file.hpp): version at 8, declared size at 16, and the
-// scale flag (version 2) after the first 128 bytes.
-constexpr std::size_t kVersionOffset = 8, kSizeOffset = 16, kScaleFlagOffset = 128;
-
-// The declared size and the checksum made to agree with the bytes again, as a writer would.
-void reseal(std::vector<char>& bytes) {
-  const std::uint64_t size = bytes.size();
-  std::memcpy(bytes.data() + kSizeOffset, &size, sizeof size);
-  const std::uint64_t sum = bow::checksum64(bytes.data(), bytes.size() - 8);
-  std::memcpy(bytes.data() + bytes.size() - 8, &sum, sizeof sum);
-}
+// Where the header's fields sit (io/map_file.hpp): version at 8, and the scale flag (version 2)
+// after the first 128 bytes.
+constexpr std::size_t kVersionOffset = 8, kScaleFlagOffset = 128;
+using test::resealMapFile;
 
 MapFileInfo monocularExpectation() {
   MapFileInfo info = expectation();
@@ -332,7 +325,7 @@ TEST(MapFile, RecordsWhetherTheScaleIsMetric) {
 
   std::vector<char> bytes = readBytes(file);
   bytes[kScaleFlagOffset] = 2;
-  reseal(bytes);
+  resealMapFile(bytes);
   writeBytes(file, bytes);
   expectLoadError(file, monocularExpectation(), "scale flag neither metric (1) nor arbitrary (0)");
   fs::remove(file);
@@ -350,7 +343,7 @@ TEST(MapFile, VersionOneFilesLoadWithTheScaleOfTheirSensor) {
     ASSERT_EQ(bytes[kVersionOffset], 2);
     bytes[kVersionOffset] = 1;
     bytes.erase(bytes.begin() + kScaleFlagOffset, bytes.begin() + kScaleFlagOffset + 4);
-    reseal(bytes);
+    resealMapFile(bytes);
     writeBytes(file, bytes);
     Map loaded;
     const MapFileInfo info = readMapFile(file, loaded, expected);
@@ -358,7 +351,7 @@ TEST(MapFile, VersionOneFilesLoadWithTheScaleOfTheirSensor) {
     EXPECT_EQ(loaded.keyFrameCount(), map.keyFrameCount());
     EXPECT_EQ(loaded.mapPointCount(), map.mapPointCount());
     bytes[kVersionOffset] = 3;  // a newer format than this reader knows
-    reseal(bytes);
+    resealMapFile(bytes);
     writeBytes(file, bytes);
     expectLoadError(file, expected, "map file format version 3, this orbis reads versions 1 to 2");
     fs::remove(file);

@@ -131,17 +131,14 @@ TEST(MonocularSlam, SyntheticLoopInitialisesEarlyAndTracksUnderOnePercentOfPath)
   EXPECT_LT(ate.stats.rmse, 0.01 * length);
 }
 
-// The first `count` frames of the 320x240 loop (seed 41) with image noise sigma 4.
+// The first `count` frames of the shared 320x240 loop with image noise (slam_test_util.hpp),
+// seed 41.
 struct LowResolutionLoop {
   synth::SynthOptions options;
   std::vector<synth::SynthFrame> frames;
 };
 LowResolutionLoop lowResolutionNoisyLoop(int count) {
-  LowResolutionLoop loop{monoOptions(300, 41), {}};
-  loop.options.width = 320;
-  loop.options.height = 240;
-  loop.options.fx = 250;
-  loop.options.noiseSigma = 4;
+  LowResolutionLoop loop{test::loopSequence(41), {}};
   synth::SyntheticSequence seq(loop.options);
   for (int i = 0; i < count; ++i) loop.frames.push_back(seq.render(i, false, false));
   return loop;
@@ -166,9 +163,10 @@ TEST(MonocularSlam, LowResolutionLoopInitialisesWithinThirtyFrames) {
 
 // Threaded, tracking must not run on against a keyframe mapping has not finished with: on a
 // slow machine (ThreadSanitizer; one core shared with a busy loop) the map shrank several-fold
-// within 30 frames of initialisation and the loop closed with a Sim(3) scale of 0.01-0.14. A
-// frame rate of 1000 Hz leaves tracking no time in the frame period, as there; the scale of the
-// last 30 frames must stay that of the first 30.
+// within 30 frames of initialisation and the loop closed with a Sim(3) scale of 0.01-0.14. The
+// frames are fed as fast as tracking takes them, and a frame rate of 1000 Hz leaves no time in
+// the frame period, as there: a wait bounded by the period (a live camera's) would give mapping
+// nothing. The scale of the last 30 frames must stay that of the first 30.
 TEST(MonocularSlam, ThreadedTrackingWithNoTimeToSpareKeepsTheScale) {
   const auto [options, frames] = lowResolutionNoisyLoop(90);
   const MonoRun run = runMono(options, frames, {.threaded = true, .fps = 1000.0});

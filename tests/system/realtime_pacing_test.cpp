@@ -3,23 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "orbis/synth/writers.hpp"
 #include "orbis/system/dataset_runner.hpp"
+#include "slam_test_util.hpp"
+#include "test_data.hpp"
 
 namespace {
 
 using namespace orbis;
 namespace fs = std::filesystem;
-
-std::string readFile(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 RunReport runTenFrames(const fs::path& sequence, const fs::path& out, bool realtime) {
   auto dataset = openDataset(DatasetKind::TumRgbd, sequence);
@@ -36,14 +29,9 @@ RunReport runTenFrames(const fs::path& sequence, const fs::path& out, bool realt
 TEST(RealtimePacing, TenFramesAtTenHertzTakeNineTenthsOfASecond) {
   const fs::path dir = fs::temp_directory_path() / "orbis_realtime_pacing";
   fs::remove_all(dir);
-  synth::SynthOptions o;
+  synth::SynthOptions o = test::loopSequence(3);
   o.frames = 10;
   o.fps = 10;  // timestamps 0.1 s apart: the last frame is due 0.9 s after the first
-  o.width = 320;
-  o.height = 240;
-  o.fx = 250;
-  o.seed = 3;
-  o.threads = 2;
   synth::SyntheticSequence sequence(o);
   synth::writeSynthSequence(sequence, synth::SynthLayout::Tum, dir / "sequence");
 
@@ -53,7 +41,7 @@ TEST(RealtimePacing, TenFramesAtTenHertzTakeNineTenthsOfASecond) {
   EXPECT_GE(paced.seconds, 0.85);
   const RunReport unpaced = runTenFrames(dir / "sequence", dir / "unpaced", false);
   EXPECT_EQ(unpaced.stats.frames, 10u);
-  EXPECT_EQ(readFile(dir / "paced" / "trajectory.txt"), readFile(dir / "unpaced" / "trajectory.txt"));
+  EXPECT_EQ(test::fileBytes(dir / "paced" / "trajectory.txt"), test::fileBytes(dir / "unpaced" / "trajectory.txt"));
   fs::remove_all(dir);
 }
 

@@ -99,13 +99,6 @@ TEST(SlamPipeline, BlackAndZeroDepthFramesAreSurvived) {
   EXPECT_GE(run.stats.keyFrames, 1u);
 }
 
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 RunReport runReal(DatasetReader& dataset, const fs::path& out) {
   RunOptions options;
   options.vocabulary = defaultVocabularyPath();
@@ -129,7 +122,7 @@ TEST(SlamPipeline, TumTeddyRgbdDeterministic) {
   EXPECT_LT(*a.ateRmse, 0.006);
   const fs::path out2 = fs::temp_directory_path() / "orbis_teddy_b";
   runReal(*dataset, out2);
-  EXPECT_EQ(readFile(out / "trajectory.txt"), readFile(out2 / "trajectory.txt"));
+  EXPECT_EQ(test::fileBytes(out / "trajectory.txt"), test::fileBytes(out2 / "trajectory.txt"));
   for (const char* f : {"keyframes.txt", "report.json", "map.ply", "overview.png"}) EXPECT_TRUE(fs::exists(out / f)) << f;
 }
 

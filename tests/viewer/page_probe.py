@@ -96,6 +96,11 @@ class Chromium:
             self.process.wait()
 
 
+def cpu_seconds(stat_fields, ticks):
+    """User + system CPU seconds from the fields of /proc/.../stat after "(comm)"."""
+    return (int(stat_fields[11]) + int(stat_fields[12])) / ticks  # utime, stime
+
+
 def process_tree_cpu(root_pid):
     """CPU seconds (user + system) of root_pid and its descendants, summed by Chromium --type."""
     ticks = os.sysconf("SC_CLK_TCK")
@@ -112,7 +117,7 @@ def process_tree_cpu(root_pid):
             continue
         pid = int(entry)
         parents[pid] = int(fields[1])
-        cpu[pid] = (int(fields[11]) + int(fields[12])) / ticks  # utime, stime
+        cpu[pid] = cpu_seconds(fields, ticks)
         # Chromium rewrites its children's titles: the arguments may come as one string.
         kind = re.search(rb"--type=([\w-]+)", b" ".join(argv))
         kinds[pid] = kind.group(1).decode() if kind else "browser"
@@ -145,8 +150,7 @@ def thread_cpu(pid, ticks):
         except OSError:
             continue
         name = re.sub(r"\d+$", "", head.split("(", 1)[1])
-        fields = tail.split()
-        seconds[name] = seconds.get(name, 0) + (int(fields[11]) + int(fields[12])) / ticks
+        seconds[name] = seconds.get(name, 0) + cpu_seconds(tail.split(), ticks)
     return seconds
 
 
@@ -225,8 +229,6 @@ def parse_arguments():
     parser.add_argument("--timeout", type=float, default=120)
     parser.add_argument("--ready-file", help="written once the browser has started; then the page is loaded as soon "
                         "as URL answers (so a benchmark can start the browser before the server)")
-    parser.add_argument("--eval", help="JavaScript to run once the page has loaded (e.g. to switch a part of it off "
-                        "and see what that part costs)")
     parser.add_argument("--poll", type=float, default=0.2, help="seconds between two checks of --until")
     parser.add_argument("--settle", type=float, default=0.5, help="seconds between the condition and the shot")
     parser.add_argument("--size", default="1400x800")
@@ -265,10 +267,6 @@ def main():
         deadline = time.monotonic() + args.timeout
         signal.signal(signal.SIGTERM, stop_on_sigterm)
         try:
-            if args.eval:
-                while evaluate("document.readyState") != "complete":
-                    time.sleep(0.05)
-                evaluate(args.eval)
             held = wait_until(evaluate, args.until, deadline, args.poll, args.settle)
             if args.then:  # the first report and the screenshot now, the last one below
                 print(evaluate(args.report), flush=True)

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -106,6 +107,14 @@ class SlamCore {
   const LoopCloser<Sensor>* loopCloser() const { return loopCloser_.get(); }
 
  private:
+  // Threaded monocular after a new keyframe: waits for local mapping (see the definition).
+  void waitForMappingAfterKeyFrame(std::chrono::steady_clock::time_point trackingStart, double extractionMs);
+  // Threaded monocular with a live camera: that wait is bounded by the frame period, which
+  // track() then times from its start.
+  bool waitBoundedByFramePeriod() const {
+    return !Sensor::kMetricScale && options_.liveCamera && !options_.deterministic;
+  }
+
   const Camera camera_;  // every stage below holds a reference to it
   std::shared_ptr<const OrbVocabulary> vocabulary_;
   MapIntrinsics intrinsics_;

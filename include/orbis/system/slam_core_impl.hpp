@@ -65,9 +65,9 @@ template <SensorConfiguration Sensor>
 TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> features, double timestamp,
                                     double extractionMs, const cv::Mat& image) {
   using Clock = std::chrono::steady_clock;
-  // Read only by the frame observer and live-camera monocular's wait for mapping below: no clock
-  // call on the stereo/RGB-D path without a viewer.
-  const bool timed = frameObserver_ || (!Sensor::kMetricScale && options_.liveCamera && !options_.deterministic);
+  // Read only by the frame observer and a wait bounded by the frame period: no clock call on the
+  // stereo/RGB-D path without a viewer.
+  const bool timed = frameObserver_ || waitBoundedByFramePeriod();
   const Clock::time_point start = timed ? Clock::now() : Clock::time_point{};
   std::shared_ptr<const FrameFeatures> observed = frameObserver_ ? features : nullptr;
   Frame<Camera> frame;
@@ -93,32 +93,8 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     mapper_->runUntilIdle();
     if (loopCloser_) loopCloser_->runUntilIdle();
   }
-  // Threaded monocular: a keyframe makes map only once mapping has triangulated it and local BA
-  // has refined it, so after a new keyframe tracking waits until local mapping is idle. A
-  // tracker that went on against the keyframe's neighbourhood while mapping still worked on it
-  // drifted in scale whenever it outran mapping: frames fed faster than the camera's rate (orbis
-  // run feeds as fast as tracking goes; KITTI 06 monocular: 30 of 51 frames lost once, ATE twice
-  // the deterministic) or a slow machine (ThreadSanitizer, about 10x slower: the rendered loop's
-  // Sim(3) correction had scale 0.014 and keyframe ATE 482 mm; the same collapse in two of three
-  // runs with tracking given no time for mapping, none in four with this wait). Waiting only out
-  // the rest of the frame period was not enough: on a slow machine nothing of it is left. Waiting
-  // for triangulation alone was not either (one of four runs collapsed): the refinement counts.
-  // The metric sensors need no such wait, since each frame measures its own depth. The wait
-  // costs wall time (teddy monocular: 7 s -> 11 s for 6.7 s of frames on two cores), so with a
-  // live camera (SlamOptions::liveCamera) tracking keeps the camera's rate instead: it gives
-  // mapping only what is left of the frame period (1/fps after extraction and tracking), as
-  // before, and runs on if mapping has not finished, rather than fall behind the camera.
   if constexpr (!Sensor::kMetricScale) {
-    if (!options_.deterministic && result.newKeyFrame) {
-      ScopedStage stage(&timer_, "tracking: wait for mapping");
-      if (options_.liveCamera) {
-        const auto period = std::chrono::duration<double>(1.0 / std::max(1.0, options_.fps));
-        const auto spent = Clock::now() - start + std::chrono::duration<double, std::milli>(extractionMs);
-        if (spent < period) mapper_->waitUntilIdleFor(std::chrono::duration_cast<Clock::duration>(period - spent));
-      } else {
-        mapper_->waitUntilIdle();
-      }
-    }
+    if (!options_.deterministic && result.newKeyFrame) waitForMappingAfterKeyFrame(start, extractionMs);
   }
   if (frameObserver_) {
     ScopedStage stage(&timer_, "tracking: observer");  // what watching costs the tracking thread
@@ -175,6 +151,31 @@ template <SensorConfiguration Sensor>
 RelocalisationStats SlamCore<Sensor>::relocalisationStats() const {
   std::lock_guard lock(map_.mutex());
   return relocaliser_->stats();
+}
+
+// A monocular keyframe makes map only once mapping has triangulated it and local BA has refined
+// it. A tracker that went on against the keyframe's neighbourhood while mapping still worked on
+// it drifted in scale whenever it outran mapping: frames fed faster than the camera's rate (orbis
+// run feeds them as fast as tracking goes) or a slow machine (under ThreadSanitizer the rendered
+// loop closed with a Sim(3) scale of 0.014, keyframe ATE 482 mm). Waiting out only the rest of
+// the frame period is not enough there: nothing of it is left; waiting for triangulation alone
+// was not either (one of four runs collapsed). So tracking waits until mapping is idle. That costs
+// wall time (teddy monocular: 11 s for 6.7 s of frames on two cores, 7 s without), so with a live
+// camera (SlamOptions::liveCamera) tracking keeps the camera's rate instead: mapping gets what is
+// left of the frame period (1/fps after extraction and tracking), and tracking runs on if it has
+// not finished. The metric sensors need no wait: each frame measures its own depth.
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::waitForMappingAfterKeyFrame(std::chrono::steady_clock::time_point trackingStart,
+                                                   double extractionMs) {
+  using Clock = std::chrono::steady_clock;
+  ScopedStage stage(&timer_, "tracking: wait for mapping");
+  if (!waitBoundedByFramePeriod()) {
+    mapper_->waitUntilIdle();
+    return;
+  }
+  const auto period = std::chrono::duration<double>(1.0 / std::max(1.0, options_.fps));
+  const auto spent = Clock::now() - trackingStart + std::chrono::duration<double, std::milli>(extractionMs);
+  if (spent < period) mapper_->waitUntilIdleFor(std::chrono::duration_cast<Clock::duration>(period - spent));
 }
 
 template <SensorConfiguration Sensor>

@@ -69,12 +69,13 @@ class QueueWorker {
 
   bool threaded() const { return thread_.joinable(); }
   bool busy() const { return busy_.load(); }
+  // Nothing queued and nothing being served.
+  bool idle() const { return size() == 0 && !busy(); }
   bool finishing() const { return finish_.load(); }
 
   // `alsoIdle` adds the owner's own condition (for instance no full BA running).
   void waitUntilIdle(const std::function<void()>& drainInline, const std::function<bool()>& alsoIdle = {}) {
-    while (true) {
-      if (size() == 0 && !busy() && (!alsoIdle || alsoIdle())) return;
+    while (!idle() || (alsoIdle && !alsoIdle())) {
       if (!threaded()) {
         drainInline();
         return;
@@ -84,13 +85,13 @@ class QueueWorker {
   }
 
   // Threaded: as waitUntilIdle, but for at most `budget`; true when idle.
-  bool waitUntilIdleFor(std::chrono::steady_clock::duration budget, const std::function<bool()>& alsoIdle = {}) {
+  bool waitUntilIdleFor(std::chrono::steady_clock::duration budget) {
     const auto deadline = std::chrono::steady_clock::now() + budget;
-    while (true) {
-      if (size() == 0 && !busy() && (!alsoIdle || alsoIdle())) return true;
+    while (!idle()) {
       if (std::chrono::steady_clock::now() >= deadline) return false;
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
+    return true;
   }
 
   void stop() {
