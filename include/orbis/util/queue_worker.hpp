@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <algorithm>
 #include <deque>
 #include <functional>
 #include <mutex>
@@ -41,7 +42,12 @@ class QueueWorker {
         if (finishing()) break;
         busy_ = true;
         serve();
-        busy_ = false;
+        {
+          // Under the mutex, so a waiter between its check and its wait cannot miss the change.
+          std::lock_guard lock(mutex_);
+          busy_ = false;
+        }
+        idleCv_.notify_all();
       }
     });
   }
@@ -75,23 +81,16 @@ class QueueWorker {
 
   // `alsoIdle` adds the owner's own condition (for instance no full BA running).
   void waitUntilIdle(const std::function<void()>& drainInline, const std::function<bool()>& alsoIdle = {}) {
-    while (!idle() || (alsoIdle && !alsoIdle())) {
-      if (!threaded()) {
-        drainInline();
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    if (!threaded()) {
+      if (!idle() || (alsoIdle && !alsoIdle())) drainInline();
+      return;
     }
+    waitIdleUntil(std::nullopt, alsoIdle);
   }
 
   // Threaded: as waitUntilIdle, but for at most `budget`; true when idle.
   bool waitUntilIdleFor(std::chrono::steady_clock::duration budget) {
-    const auto deadline = std::chrono::steady_clock::now() + budget;
-    while (!idle()) {
-      if (std::chrono::steady_clock::now() >= deadline) return false;
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-    return true;
+    return waitIdleUntil(std::chrono::steady_clock::now() + budget, {});
   }
 
   void stop() {
@@ -101,8 +100,24 @@ class QueueWorker {
   }
 
  private:
+  // Woken when the worker finishes serving, so a waiter returns as soon as it is idle. `alsoIdle`
+  // flags change without a notification: they are looked at again every few milliseconds.
+  bool waitIdleUntil(std::optional<std::chrono::steady_clock::time_point> deadline,
+                     const std::function<bool()>& alsoIdle) {
+    constexpr auto kRecheck = std::chrono::milliseconds(2);
+    std::unique_lock lock(mutex_);
+    while (!queue_.empty() || busy_.load() || (alsoIdle && !alsoIdle())) {
+      const auto now = std::chrono::steady_clock::now();
+      if (deadline && now >= *deadline) return false;
+      const auto until = deadline ? std::min(*deadline, now + kRecheck) : now + kRecheck;
+      idleCv_.wait_until(lock, until);
+    }
+    return true;
+  }
+
   mutable std::mutex mutex_;
   std::condition_variable cv_;
+  std::condition_variable idleCv_;  // the worker finished serving
   std::deque<Item> queue_;
   std::atomic<bool> busy_{false};
   std::atomic<bool> finish_{false};
