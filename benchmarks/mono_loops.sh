@@ -25,19 +25,9 @@
 #   ORBIS  the binary (default build/release/orbis); WORK a scratch folder (renders are kept
 #   there and reused; default: a temporary one). SIZE="W H FX" overrides 320 240 250.
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
-orbis=${ORBIS:-$root/build/release/orbis}
-work=${WORK:-$(mktemp -d)}
-read -r width height fx <<<"${SIZE:-320 240 250}"
-scene=${SCENE:-corridor}
-case $scene in
-  corridor) frames=600 extra=150 ;;  # 27 m at about 1.4 m/s
-  room) frames=300 extra=75 ;;
-  *) echo "SCENE must be corridor or room" >&2; exit 2 ;;
-esac
+source "$(dirname "$0")/mono_scenes.sh" corridor
 seeds=("$@")
 ((${#seeds[@]})) || seeds=(41 42 43)
-mkdir -p "$work"
 
 # The estimate's scale over trajectory lines [from, to) against the ground truth (sim3 ATE alignment).
 stretch_scale() {  # GT EST FROM TO
@@ -54,9 +44,7 @@ scale_drift() {  # GT EST: last 60 against first 60
 printf '%-5s %-6s %-14s %-28s %-30s %-30s %s\n' seed init tracked "loops (frame:scale)" "ATE mm loop / no-loop (ratio)" \
   "kf ATE mm loop / no-loop (ratio)" "scale end/start no-loop -> loop"
 for seed in "${seeds[@]}"; do
-  seq=$work/${scene}_${width}x${height}_$seed
-  [[ -f $seq/settings_mono.yaml ]] || "$orbis" synth "$seq" --scene "$scene" --frames "$frames" --extra "$extra" \
-    --width "$width" --height "$height" --fx "$fx" --noise 4 --seed "$seed" --threads 2 >/dev/null
+  seq=$(render_mono_scene "$seed" 2)
   for mode in loop noloop; do
     flags=(--deterministic)
     [[ $mode == noloop ]] && flags+=(--no-loop)

@@ -1,0 +1,23 @@
+# Sourced by the monocular benchmarks (mono_loops.sh, mono_scale_seeds.sh): the rendered scenes
+# they share, so both run on the same renders.
+# In: SCENE (corridor or room; the caller's default in $1), SIZE="W H FX" (default 320 240 250),
+# ORBIS, WORK. Out: orbis, work, scene, width, height, fx, frames, extra, and
+# render_mono_scene SEED THREADS, which prints the sequence folder (rendered on first use).
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+orbis=${ORBIS:-$root/build/release/orbis}
+work=${WORK:-$(mktemp -d)}
+read -r width height fx <<<"${SIZE:-320 240 250}"
+scene=${SCENE:-$1}
+case $scene in
+  corridor) frames=600 extra=150 ;;  # 27 m at about 1.4 m/s
+  room) frames=300 extra=75 ;;
+  *) echo "SCENE must be corridor or room" >&2; exit 2 ;;
+esac
+mkdir -p "$work"
+
+render_mono_scene() {  # SEED THREADS
+  local seq=$work/${scene}_${width}x${height}_$1
+  [[ -f $seq/settings_mono.yaml ]] || "$orbis" synth "$seq" --scene "$scene" --frames "$frames" --extra "$extra" \
+    --width "$width" --height "$height" --fx "$fx" --noise 4 --seed "$1" --threads "$2" >/dev/null
+  echo "$seq"
+}
