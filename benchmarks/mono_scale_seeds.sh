@@ -32,6 +32,9 @@ import json, subprocess, sys, tempfile
 orbis, seed, gt, out = sys.argv[1:5]
 report = json.load(open(f"{out}/report.json"))
 init = report["initialisation"]["frame"]
+if init is None:  # never initialised: say what it waited on
+    waits = ", ".join(f"{k} {v}" for k, v in sorted(report["initialisation"]["waits"].items()))
+    sys.exit(print(f"{seed:<5} never initialised (waited on: {waits})"))
 model = ""
 for line in open(f"{out}/stats.jsonl"):
     row = json.loads(line)
@@ -48,8 +51,8 @@ def stretch_scale(first, count=60):
                                 capture_output=True, text=True, check=True)
     return json.loads(result.stdout)["scale"]
 
-base = stretch_scale(0)
-scales = [f"{start}:{base / stretch_scale(start):.2f}" for start in range(100, len(rows) - 60, 100)]
+base = stretch_scale(0) if len(rows) >= 60 else None
+scales = [f"{start}:{base / stretch_scale(start):.2f}" for start in range(100, len(rows) - 60, 100)] if base else ["-"]
 after = report["frames"] - init
 print(f'{seed:<5} {init:<4} {model:<8} {report["frames_tracked"] - 1}/{after:<6} '
       f'{report["ate"]["rmse"] * 1000:8.1f}   {" ".join(scales)}')
