@@ -9,8 +9,8 @@
 #   tracked  frames tracked after initialisation / frames after initialisation
 #   ATE      Sim(3)-aligned ATE over all frames (mm)
 #   scale    the estimate's size over 60-frame stretches starting every 100 frames, against the
-#            first 60 frames (the inverse ratio of their Sim(3) fits to the ground truth): 1 keeps
-#            the scale; a map that lost it reads well under 1 and stays there
+#            first 60 frames (relative_size in mono_scenes.sh, as mono_loops.sh's scale column): 1
+#            keeps the scale; a map that lost it reads well under 1 and stays there
 #
 # Usage: benchmarks/mono_scale_seeds.sh [SEED...]      (default seeds 41 to 48)
 #   SCENE=room|corridor (default room; the same renders as mono_loops.sh), ORBIS the binary
@@ -22,14 +22,19 @@ seeds=("$@")
 ((${#seeds[@]})) || seeds=(41 42 43 44 45 46 47 48)
 
 one_seed() {  # SEED: renders if needed, runs, prints the row
-  local seed=$1 seq out
+  local seed=$1 seq out gt rows sizes=()
   seq=$(render_mono_scene "$seed" 1)
+  gt=$seq/groundtruth.txt
   out=$work/run_${seed}_noloop
   "$orbis" run tum "$seq" --settings "$seq/settings_mono.yaml" --sensor mono --deterministic --no-loop \
     --stats --out "$out" >"$out.log" 2>&1
-  python3 - "$orbis" "$seed" "$seq/groundtruth.txt" "$out" <<'PY'
-import json, subprocess, sys, tempfile
-orbis, seed, gt, out = sys.argv[1:5]
+  rows=$(grep -vc '^#' "$out/trajectory.txt" || true)
+  for ((start = 100; start < rows - 60; start += 100)); do
+    sizes+=("$start:$(relative_size "$gt" "$out/trajectory.txt" "$start")")
+  done
+  python3 - "$seed" "$out" "${sizes[@]}" <<'PY'
+import json, sys
+seed, out, sizes = sys.argv[1], sys.argv[2], sys.argv[3:]
 report = json.load(open(f"{out}/report.json"))
 init = report["initialisation"]["frame"]
 if init is None:  # never initialised: say what it waited on
@@ -41,25 +46,13 @@ for line in open(f"{out}/stats.jsonl"):
     if row.get("kind") == "frame" and row.get("frame") == init and "initialisation_homography" in row:
         kind = "H" if row["initialisation_homography"] else "F"
         model = f'{kind} {row["initialisation_parallax_deg"]:.2f}°'
-rows = [l for l in open(f"{out}/trajectory.txt") if not l.startswith("#")]
-
-def stretch_scale(first, count=60):
-    with tempfile.NamedTemporaryFile("w", suffix=".txt") as part:
-        part.writelines(rows[first:first + count])
-        part.flush()
-        result = subprocess.run([orbis, "eval", "ate", gt, part.name, "--align", "sim3", "--json"],
-                                capture_output=True, text=True, check=True)
-    return json.loads(result.stdout)["scale"]
-
-base = stretch_scale(0) if len(rows) >= 60 else None
-scales = [f"{start}:{base / stretch_scale(start):.2f}" for start in range(100, len(rows) - 60, 100)] if base else ["-"]
 after = report["frames"] - init
 print(f'{seed:<5} {init:<4} {model:<8} {report["frames_tracked"] - 1}/{after:<6} '
-      f'{report["ate"]["rmse"] * 1000:8.1f}   {" ".join(scales)}')
+      f'{report["ate"]["rmse"] * 1000:8.1f}   {" ".join(sizes) or "-"}')
 PY
 }
 
 printf '%-5s %-13s %-10s %8s   %s\n' seed "init (model)" tracked "ATE mm" "scale against the first 60 frames"
-export -f one_seed render_mono_scene
+export -f one_seed render_mono_scene stretch_scale relative_size
 export orbis work width height fx scene frames extra
 printf '%s\n' "${seeds[@]}" | xargs -P "${JOBS:-2}" -I{} bash -c 'one_seed {}' | sort -n

@@ -1,8 +1,9 @@
 # Sourced by the monocular benchmarks (mono_loops.sh, mono_scale_seeds.sh): the rendered scenes
 # they share, so both run on the same renders.
 # In: SCENE (corridor or room; the caller's default in $1), SIZE="W H FX" (default 320 240 250),
-# ORBIS, WORK. Out: orbis, work, scene, width, height, fx, frames, extra, and
-# render_mono_scene SEED THREADS, which prints the sequence folder (rendered on first use).
+# ORBIS, WORK. Out: orbis, work, scene, width, height, fx, frames, extra;
+# render_mono_scene SEED THREADS, which prints the sequence folder (rendered on first use); and
+# relative_size GT EST FROM, the estimate's scale drift.
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 orbis=${ORBIS:-$root/build/release/orbis}
 work=${WORK:-$(mktemp -d)}
@@ -20,4 +21,20 @@ render_mono_scene() {  # SEED THREADS
   [[ -f $seq/settings_mono.yaml ]] || "$orbis" synth "$seq" --scene "$scene" --frames "$frames" --extra "$extra" \
     --width "$width" --height "$height" --fx "$fx" --noise 4 --seed "$1" --threads "$2" >/dev/null
   echo "$seq"
+}
+
+# The Sim(3) scale aligning lines [FROM, FROM + COUNT) of trajectory EST to the ground truth GT:
+# ground truth over estimate. A temporary file per call, so parallel runs do not meet.
+stretch_scale() {  # GT EST FROM COUNT
+  local part
+  part=$(mktemp)
+  grep -v '^#' "$2" | sed -n "$(($3 + 1)),$(($3 + $4))p" >"$part"
+  "$orbis" eval ate "$1" "$part" --align sim3 --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["scale"])'
+  rm -f "$part"
+}
+
+# The estimate's size over its 60 lines from FROM against its first 60 (each stretch aligned to
+# the ground truth on its own): 1 is no scale drift, under 1 the map shrank.
+relative_size() {  # GT EST FROM
+  python3 -c "print(f'{$(stretch_scale "$1" "$2" 0 60) / $(stretch_scale "$1" "$2" "$3" 60):.3f}')"
 }

@@ -24,6 +24,7 @@ constexpr char kMagic[8] = {'O', 'R', 'B', 'I', 'S', 'M', 'A', 'P'};
 constexpr std::size_t kHeaderBytesVersion1 = 8 + 4 + 4 + 8 + 8 + 10 * 8 + 8 + 8;
 constexpr std::uint32_t kFirstVersionWithScale = 2;
 constexpr std::size_t kTrailerBytes = 8;
+constexpr std::size_t kDeclaredSizeOffset = 16;  // after magic, version and sensor
 
 // Plain records for the arrays (std::pair is not trivially copyable); none has padding.
 struct NodeFeature {
@@ -194,6 +195,13 @@ std::uint64_t vocabularyChecksum(const OrbVocabulary& vocabulary) {
   return bow::checksum64(bytes.data(), bytes.size());
 }
 
+void sealMapFileBytes(std::span<char> bytes) {
+  const std::uint64_t size = bytes.size();
+  std::memcpy(bytes.data() + kDeclaredSizeOffset, &size, sizeof size);
+  const std::uint64_t checksum = bow::checksum64(bytes.data(), bytes.size() - kTrailerBytes);
+  std::memcpy(bytes.data() + bytes.size() - kTrailerBytes, &checksum, sizeof checksum);
+}
+
 void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info) {
   const std::vector<KeyFrame*> keyFrames = map.keyFrames();
   const std::vector<MapPoint*> points = map.mapPoints();
@@ -201,7 +209,7 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
   for (char c : kMagic) w.put(c);
   w.put(kMapFileVersion);
   w.put(static_cast<std::uint32_t>(info.sensor));
-  w.put<std::uint64_t>(0);  // file size, patched below
+  w.put<std::uint64_t>(0);  // file size (kDeclaredSizeOffset), filled in by sealMapFileBytes
   w.put(info.vocabularyChecksum);
   w.putIntrinsics(info.intrinsics);
   w.put<std::uint64_t>(keyFrames.size());
@@ -254,12 +262,8 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
     w.put<std::int32_t>(p->found());
     w.putArray(observations);
   }
-  std::vector<char>& bytes = w.bytes();
-  const std::uint64_t size = bytes.size() + kTrailerBytes;
-  std::memcpy(bytes.data() + 16, &size, sizeof size);
-  const std::uint64_t checksum = bow::checksum64(bytes.data(), bytes.size());
-  w.put(checksum);
-
+  w.put<std::uint64_t>(0);  // the trailer, filled in by sealMapFileBytes
+  sealMapFileBytes(w.bytes());
   writeFileAtomically(file, w.bytes());
 }
 

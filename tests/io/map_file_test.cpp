@@ -2,7 +2,6 @@
 // (truncation, a flipped bit, another vocabulary, sensor or camera) is a clear orbis::Error.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>

@@ -27,6 +27,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 
 #include "orbis/bow/vocabulary.hpp"
 #include "orbis/camera/sensor_kind.hpp"
@@ -52,6 +53,11 @@ struct MapFileInfo {
 
 // Identifies the vocabulary a map's BoW vectors belong to (checksum of its whole file block).
 std::uint64_t vocabularyChecksum(const OrbVocabulary& vocabulary);
+
+// Makes a whole map file's bytes (trailer included) agree with themselves, as writeMapFile leaves
+// them: the header's declared total size and the trailer's checksum of everything before it.
+// `bytes` must hold at least the size field and the trailer (24 bytes); nothing else is checked.
+void sealMapFileBytes(std::span<char> bytes);
 
 // Writes the good keyframes and points of `map`. Caller holds map.mutex(). Written to a
 // temporary file renamed into place, so a crash never leaves half a map under `file`.

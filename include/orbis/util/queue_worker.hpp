@@ -10,10 +10,10 @@
 // joins the worker; items still queued stay queued.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <algorithm>
 #include <deque>
 #include <functional>
 #include <mutex>
@@ -101,7 +101,8 @@ class QueueWorker {
 
  private:
   // Woken when the worker finishes serving, so a waiter returns as soon as it is idle. `alsoIdle`
-  // flags change without a notification: they are looked at again every few milliseconds.
+  // flags change without a notification: only with one is the condition looked at again every few
+  // milliseconds.
   bool waitIdleUntil(std::optional<std::chrono::steady_clock::time_point> deadline,
                      const std::function<bool()>& alsoIdle) {
     constexpr auto kRecheck = std::chrono::milliseconds(2);
@@ -109,8 +110,10 @@ class QueueWorker {
     while (!queue_.empty() || busy_.load() || (alsoIdle && !alsoIdle())) {
       const auto now = std::chrono::steady_clock::now();
       if (deadline && now >= *deadline) return false;
-      const auto until = deadline ? std::min(*deadline, now + kRecheck) : now + kRecheck;
-      idleCv_.wait_until(lock, until);
+      std::optional<std::chrono::steady_clock::time_point> until = deadline;
+      if (alsoIdle) until = std::min(deadline.value_or(now + kRecheck), now + kRecheck);
+      if (until) idleCv_.wait_until(lock, *until);
+      else idleCv_.wait(lock);  // only the worker's notification can make it idle
     }
     return true;
   }
