@@ -22,16 +22,18 @@ seeds=("$@")
 ((${#seeds[@]})) || seeds=(41 42 43 44 45 46 47 48)
 
 one_seed() {  # SEED: renders if needed, runs, prints the row
-  local seed=$1 seq out gt rows sizes=()
+  local seed=$1 seq out gt rows starts=() sizes=() k
   seq=$(render_mono_scene "$seed" 1)
   gt=$seq/groundtruth.txt
   out=$work/run_${seed}_noloop
   "$orbis" run tum "$seq" --settings "$seq/settings_mono.yaml" --sensor mono --deterministic --no-loop \
     --stats --out "$out" >"$out.log" 2>&1
   rows=$(grep -vc '^#' "$out/trajectory.txt" || true)
-  for ((start = 100; start < rows - 60; start += 100)); do
-    sizes+=("$start:$(relative_size "$gt" "$out/trajectory.txt" "$start")")
-  done
+  for ((start = 100; start < rows - 60; start += 100)); do starts+=("$start"); done
+  if ((${#starts[@]})); then
+    mapfile -t sizes < <(relative_size "$gt" "$out/trajectory.txt" "${starts[@]}")
+    for k in "${!starts[@]}"; do sizes[k]="${starts[k]}:${sizes[k]}"; done
+  fi
   python3 - "$seed" "$out" "${sizes[@]}" <<'PY'
 import json, sys
 seed, out, sizes = sys.argv[1], sys.argv[2], sys.argv[3:]

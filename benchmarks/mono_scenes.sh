@@ -3,7 +3,7 @@
 # In: SCENE (corridor or room; the caller's default in $1), SIZE="W H FX" (default 320 240 250),
 # ORBIS, WORK. Out: orbis, work, scene, width, height, fx, frames, extra;
 # render_mono_scene SEED THREADS, which prints the sequence folder (rendered on first use); and
-# relative_size GT EST FROM, the estimate's scale drift.
+# relative_size GT EST FROM..., the estimate's scale drift.
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 orbis=${ORBIS:-$root/build/release/orbis}
 work=${WORK:-$(mktemp -d)}
@@ -33,8 +33,14 @@ stretch_scale() {  # GT EST FROM COUNT
   rm -f "$part"
 }
 
-# The estimate's size over its 60 lines from FROM against its first 60 (each stretch aligned to
-# the ground truth on its own): 1 is no scale drift, under 1 the map shrank.
-relative_size() {  # GT EST FROM
-  python3 -c "print(f'{$(stretch_scale "$1" "$2" 0 60) / $(stretch_scale "$1" "$2" "$3" 60):.3f}')"
+# The estimate's size over its 60 lines from each FROM against its first 60 (each stretch aligned
+# to the ground truth on its own), one per FROM on a line: 1 is no scale drift, under 1 the map
+# shrank. The first 60 lines are aligned once for all FROMs.
+relative_size() {  # GT EST FROM...
+  local gt=$1 est=$2 first from
+  shift 2
+  first=$(stretch_scale "$gt" "$est" 0 60)
+  for from in "$@"; do
+    python3 -c "print(f'{$first / $(stretch_scale "$gt" "$est" "$from" 60):.3f}')"
+  done
 }
