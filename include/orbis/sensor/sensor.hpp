@@ -58,18 +58,10 @@ concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, cons
 
 // A rectified stereo pair: ORB on both images, then stereo matching along rows (§III-A); the
 // two extractions run in parallel. OrbParams::rightFeaturesFactor (settings key
-// ORBextractor.rightFeaturesFactor) scales the right image's budget. With ORB-SLAM2's equal
-// budgets the two quadtrees keep different corners, and 55% of left keypoints find a partner
-// on the synthetic room; 3x gives 71% at the same disparity accuracy
-// (tests/features/synthetic_stereo_test.cpp). But more stereo points mean more tracked close
-// points, so the paper's keyframe rule (fewer than 100 tracked close points) fires less: on the
-// synthetic stereo loop 3x made 52/50/44 keyframes instead of 68/60/53 and measured worse
-// (benchmarks/eval_accuracy.sh: 39.9 against 28.1 mm closed, 92.1 against 69.1 mm open; KITTI
-// 06 52.7 against 53.5 mm). Raising that threshold to 140 restored the keyframes and most of
-// the accuracy (31.8 / 65.6 mm), which confirms the cause. Four more rendered stereo loops
-// (seeds 31-34, budget 800) agree: 3x made 36-40 keyframes instead of 44-50, 36.0 against
-// 29.5 mm closed, 87.8 against 79.0 mm open (geometric means). The default keeps ORB-SLAM2's
-// equal budgets and the paper's rule.
+// ORBextractor.rightFeaturesFactor) scales the right image's budget. The default keeps
+// ORB-SLAM2's equal budgets: a larger right budget matches more keypoints but, through the
+// paper's keyframe rule, makes fewer keyframes and measured worse
+// (docs/notes/2026-11-23-stereo-right-features-factor.md).
 struct Stereo {
   using Camera = RectifiedStereoCamera<double>;
   using Input = StereoInput;
