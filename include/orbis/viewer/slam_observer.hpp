@@ -48,6 +48,7 @@ struct KeyFrameSnapshot {
   std::uint64_t frameIndex = 0;
   SE3d Twc;
   std::int64_t parent = -1;  // spanning tree; -1 at the root
+  std::uint32_t mapId = 0;   // its map of the atlas (the viewer colours each map)
   std::vector<KeyFrameId> covisibles, loopEdges;  // covisibles: weight >= kStrongCovisibility
 };
 
@@ -62,6 +63,7 @@ struct MapSnapshot {
   std::vector<KeyFrameSnapshot> keyFrames;
   std::vector<MapPointSnapshot> points;
   std::vector<LoopClosureEvent> loopClosures;
+  std::vector<MapMergeEvent> merges;  // maps of the atlas merged, in order
   std::vector<Eigen::Vector3f> trajectory;  // camera centres of the tracked frames
   std::size_t frames = 0;
 };
