@@ -6,9 +6,10 @@ For each seed and blackout START:COUNT it renders the corridor loop (`orbis synt
 then runs RGB-D, stereo and monocular, --deterministic, with the atlas and with --single-map, and
 prints one row per run: frames tracked after the blackout, ATE over every tracked frame (SE(3);
 Sim(3) for monocular), maps opened, the frame the new map started on and the frame of the merge,
-and the seam error: the relative pose between the last frame tracked before the blackout and
-the first frame of the new map, against the ground truth (translation error, metres; monocular
-in ground-truth units after the ATE's scale). Pure Python (no NumPy); the JSON of every row goes
+the seam error: the relative pose between the frames of the two keyframes the merge matched (one
+per map) against the ground truth (translation error, mm; monocular in ground-truth units at the
+run's scale), and the gap error: the same across the blackout (the last frame of the first map and
+the first of the next), which only the rest of the loop ties together. Pure Python (no NumPy); the JSON of every row goes
 to WORK/atlas_corridor.json.
 
   benchmarks/atlas_corridor.py [--orbis BIN] [--work DIR] [--seeds 1,2] [--blackouts 100:30,200:30]
@@ -102,25 +103,35 @@ def score(out, gt, start, count, sensor):
         "ate_mm": 1000 * report["ate"]["rmse"] if report.get("ate") else None,
         "maps": len(report.get("maps", [])) or 1,
         "new_map_frame": None, "merge_frame": None, "merge_inliers": None, "merge_ms": None, "seam_error_mm": None,
+        "gap_error_mm": None,
     }
     if len(report.get("maps", [])) > 1:
         row["new_map_frame"] = report["maps"][1]["start_frame"]
     if report.get("merges"):
         m = report["merges"][0]
         row.update(merge_frame=m["frame"], merge_inliers=m["inliers"], merge_ms=round(m["ms"], 1))
-    # The seam: the last frame of the first map before the blackout and the first of the next map.
+    # The seam: the frames of the two keyframes the merge matched (one per map), and across the
+    # blackout: the last frame of the first map and the first of the next (nothing ties them but
+    # the rest of the loop).
+    scale = 1.0
+    if sensor == "mono":  # the map's unit: estimated over true distance along the whole run
+        keys = sorted(i for i in est if i in gt)
+        dist = lambda p: sum(math.dist(p[keys[j]][1], p[keys[j + 1]][1]) for j in range(len(keys) - 1))
+        scale = dist(gt) / max(dist(est), 1e-9)
+
+    def relative_error(a, b):
+        e, g = relative_translation(est[a], est[b]), relative_translation(gt[a], gt[b])
+        return 1000 * math.dist([scale * x for x in e], g)
+
+    if report.get("merges"):
+        m = report["merges"][0]
+        if m["frame"] in est and m["other_frame"] in est:
+            row["seam_error_mm"] = relative_error(m["other_frame"], m["frame"])
+            row["seam_frames"] = (m["other_frame"], m["frame"])
     before = [i for i in est if i < start and maps.get(i) == 0]
     after = sorted(i for i in est if i >= end and maps.get(i, 0) != 0)
     if before and after and report.get("merges"):
-        a, b = max(before), after[0]
-        e, g = relative_translation(est[a], est[b]), relative_translation(gt[a], gt[b])
-        scale = 1.0
-        if sensor == "mono":  # the map's unit: estimated over true distance along the whole run
-            keys = sorted(i for i in est if i in gt)
-            dist = lambda p, k: sum(math.dist(p[keys[j]][1], p[keys[j + 1]][1]) for j in range(len(keys) - 1))
-            scale = dist(gt, keys) / max(dist(est, keys), 1e-9)
-        row["seam_error_mm"] = 1000 * math.dist([scale * x for x in e], g)
-        row["seam_frames"] = (a, b)
+        row["gap_error_mm"] = relative_error(max(before), after[0])
     return row
 
 
@@ -135,7 +146,7 @@ def main():
     os.makedirs(args.work, exist_ok=True)
     rows = []
     print(f"{'sensor':7} {'seed':>4} {'blackout':>9} {'mode':7} {'after':>9} {'ATE mm':>8} {'maps':>4} "
-          f"{'new map':>7} {'merge':>5} {'inl':>4} {'seam mm':>8}")
+          f"{'new map':>7} {'merge':>5} {'inl':>4} {'seam mm':>8} {'gap mm':>8}")
     for seed in args.seeds.split(","):
         for black in args.blackouts.split(","):
             start, count = (int(x) for x in black.split(":"))
@@ -162,7 +173,7 @@ def main():
                               f"{row['tracked_after_blackout']:>4}/{row['frames_after_blackout']:<4} "
                               f"{fmt(row['ate_mm'], '8.1f')} {row['maps']:>4} {fmt(row['new_map_frame'], '>7')} "
                               f"{fmt(row['merge_frame'], '>5')} {fmt(row['merge_inliers'], '>4')} "
-                              f"{fmt(row['seam_error_mm'], '8.1f')}", flush=True)
+                              f"{fmt(row['seam_error_mm'], '8.1f')} {fmt(row['gap_error_mm'], '8.1f')}", flush=True)
     json.dump(rows, open(os.path.join(args.work, "atlas_corridor.json"), "w"), indent=1)
 
 

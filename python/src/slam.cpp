@@ -101,7 +101,7 @@ void bindQueries(py::class_<SlamSession<Sensor>>& c) {
           [](Session& s) {
             py::list out;
             for (const MapMergeEvent& e : s.locked([](S& slam) { return slam.core().merges(); }))
-              out.append(py::dict("frame"_a = e.frameIndex, "current_keyframe"_a = e.current,
+              out.append(py::dict("frame"_a = e.frameIndex, "other_frame"_a = e.otherFrameIndex, "current_keyframe"_a = e.current,
                                   "other_keyframe"_a = e.other, "active_map"_a = e.activeMap,
                                   "other_map"_a = e.otherMap, "moved_map"_a = e.movedMap, "kept_map"_a = e.keptMap,
                                   "inliers"_a = e.inliers, "fused_points"_a = e.fusedPoints, "scale"_a = e.scale,

@@ -81,7 +81,8 @@ void writeAtlas(JsonWriter& w, const RunReport& r) {
   w.endArray();
   w.key("merges").beginArray();
   for (const MapMergeEvent& e : r.merges) {
-    w.beginObject().field("frame", e.frameIndex).field("current_keyframe", e.current).field("other_keyframe", e.other);
+    w.beginObject().field("frame", e.frameIndex).field("other_frame", e.otherFrameIndex);
+    w.field("current_keyframe", e.current).field("other_keyframe", e.other);
     w.field("active_map", std::size_t{e.activeMap}).field("other_map", std::size_t{e.otherMap}).field("moved_map", std::size_t{e.movedMap});
     w.field("kept_map", std::size_t{e.keptMap}).field("moved_keyframes", e.movedKeyFrames).field("moved_points", e.movedPoints);
     w.field("inliers", e.inliers).field("fused_points", e.fusedPoints).field("scale", e.scale);

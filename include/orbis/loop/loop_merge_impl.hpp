@@ -43,6 +43,7 @@ void LoopCloser<Sensor>::mergeMaps(KeyFrame* kf, LoopCandidate& place) {
     event.current = kf->id;
     event.other = otherKf->id;
     event.frameIndex = kf->frameIndex;
+    event.otherFrameIndex = otherKf->frameIndex;
     event.activeMap = kf->mapId();
     event.otherMap = otherKf->mapId();
     event.inliers = place.matched;

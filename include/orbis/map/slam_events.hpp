@@ -36,6 +36,7 @@ struct LoopClosureEvent {
 struct MapMergeEvent {
   KeyFrameId current = 0, other = 0;  // the active map's keyframe and the other map's it matched
   std::uint64_t frameIndex = 0;       // frame the current keyframe was made from
+  std::uint64_t otherFrameIndex = 0;  // frame the other map's keyframe was made from
   std::uint32_t activeMap = 0, otherMap = 0;
   std::uint32_t movedMap = 0, keptMap = 0;
   std::size_t movedKeyFrames = 0, movedPoints = 0;
