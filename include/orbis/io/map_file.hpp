@@ -39,17 +39,26 @@
 
 namespace orbis {
 
+// The map file format's version, written in the header.
 inline constexpr std::uint32_t kMapFileVersion = 3;
 
+// What a map file's header records.
 struct MapFileInfo {
+  // The sensor that made the map.
   SensorKind sensor = SensorKind::Stereo;
   MapIntrinsics intrinsics;  // of the system that saved it (fx, fy, cx, cy, bf are checked)
+  // Checksum of the vocabulary the map's bag-of-words vectors refer to.
   std::uint64_t vocabularyChecksum = 0;
+  // @{
+  // Keyframes and map points in the file.
   std::uint64_t keyFrames = 0, mapPoints = 0;
+  // @}
+  // @{
   // Not in the file: when non-zero, what readMapFile's caller's vocabulary holds. Every word and
   // node id of the keyframes' BoW and feature vectors must be below them (a corrupt id would
   // size the keyframe database's inverted index, or index the vocabulary, far out of bounds).
   std::uint64_t vocabularyWords = 0, vocabularyNodes = 0;
+  // @}
   // False: the map's unit is arbitrary (a monocular map; Sensor::kMetricScale). Read back from
   // the file and checked against the caller's.
   bool metricScale = true;

@@ -31,21 +31,32 @@ namespace orbis {
 // SensorKind, its names and their parser: orbis/camera/sensor_kind.hpp (shared with the dataset
 // readers and the command line).
 
+// The camera a settings file describes, by sensor: the one std::variant; code past it runs on the
+// concrete type.
 using CameraVariant = std::variant<PinholeCamera<double>, RectifiedStereoCamera<double>, RgbdCamera<double>>;
 
+// ORB-SLAM2's LEFT./RIGHT. rectification blocks of a stereo settings file.
 struct StereoRectificationBlocks {
+  // @{
+  // The left and right camera's block.
   RectificationBlock left, right;
+  // @}
 
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
+// An ORB-SLAM2 settings file, read: the sensor, its camera and the extractor's parameters
+// (docs/guide/settings.md lists every key).
 struct Settings {
+  // The file read.
   std::filesystem::path source;
+  // The sensor chosen (argument, Sensor key, or inferred).
   SensorKind sensor = SensorKind::Monocular;
   // PinholeCamera for mono, RectifiedStereoCamera for stereo, RgbdCamera for rgbd; stereo and
   // RGB-D carry baseline = Camera.bf / Camera.fx and closeDepth = ThDepth * baseline.
   CameraVariant camera;
   RadTanDistortion<double> distortion;  // of the input images (Camera.k1..k3); zero if rectified
+  // The ORBextractor.* parameters.
   OrbParams orb;
   double fps = 30.0;           // Camera.fps (0 or absent: 30, as ORB-SLAM2)
   bool rgbOrder = true;        // Camera.RGB: colour images arrive as RGB (1) or BGR (0)
@@ -56,7 +67,10 @@ struct Settings {
   std::optional<StereoRectificationBlocks> rectification;  // LEFT./RIGHT. blocks, if present
   std::uint32_t seed = 0;      // System.seed: seeds every random choice of the system
 
+  // Reads file, choosing the sensor from its Sensor key or its keys; throws orbis::Error naming the
+  // file and key.
   static Settings load(const std::filesystem::path& file);
+  // Reads file as the given sensor.
   static Settings load(const std::filesystem::path& file, SensorKind sensor);
 
   // Remap tables from the LEFT./RIGHT. blocks; throws orbis::Error when the file has none.

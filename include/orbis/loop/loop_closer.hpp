@@ -59,7 +59,9 @@
 
 namespace orbis {
 
+// Loop closing's thresholds (ORB-SLAM2's unless noted).
 struct LoopCloserOptions {
+  // Runs on its own thread (false: inline, deterministic mode).
   bool threaded = true;
   std::uint32_t seed = 0;               // RANSAC generator
   int consistencyThreshold = 3;         // consecutive keyframes a candidate group must persist
@@ -68,8 +70,11 @@ struct LoopCloserOptions {
   int minPoseInliers = 20;              // after guided matching and refinement
   int minLoopMatches = 40;              // after projecting the loop neighbourhood
   int essentialGraphMinWeight = 100;    // covisibility edges kept in the essential graph
+  // @{
+  // Whether a full BA runs after a loop correction, and its iterations.
   bool fullBundleAdjustment = true;
   int fullBundleAdjustmentIterations = 10;
+  // @}
   // Merging maps of the atlas: on, and the active map's keyframes a merge needs.
   bool mergeMaps = true;
   int mergeMinKeyFrames = 5;
@@ -78,9 +83,12 @@ struct LoopCloserOptions {
 };
 
 
+// Loop closing (§III-D, §V): detection by bag of words, a verified Sim(3) (SE(3) for metric
+// sensors), loop fusion, essential-graph optimisation, then a full BA on a worker.
 template <SensorConfiguration Sensor>
 class LoopCloser {
  public:
+  // The sensor's camera model.
   using Camera = typename Sensor::Camera;
   // The loop's correction of a pose: rigid for metric sensors, a similarity for monocular.
   using Correction = std::conditional_t<Sensor::kMetricScale, SE3d, Sim3d>;
@@ -98,8 +106,10 @@ class LoopCloser {
   void runUntilIdle();
   // Block until the queue is empty, the worker idle and no full BA is running.
   void waitUntilIdle();
+  // Finishes queued work and joins the threads.
   void shutdown();
 
+  // The loops closed so far, in order.
   std::vector<LoopClosureEvent> closures() const;
   std::vector<MapMergeEvent> merges() const;
 

@@ -33,28 +33,39 @@ struct AtlasMapRecord {
   std::optional<std::uint32_t> mergedInto;  // set once it has been merged into another map
 };
 
+// The map: owns every keyframe and map point (bad ones too, so pointers stay valid), guarded by one
+// mutex.
 class Map {
  public:
   Map() = default;
   Map(const Map&) = delete;
   Map& operator=(const Map&) = delete;
 
+  // The map's mutex: held by whoever reads or changes keyframes, points or graphs.
   std::mutex& mutex() const { return mutex_; }
 
+  // Creates a keyframe with the next id.
   KeyFrame* createKeyFrame(std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
                            std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
                            bow::BowVector bowVector, bow::FeatureVector featureVector);
+  // Creates a map point with the next id.
   MapPoint* createMapPoint(const Eigen::Vector3d& position, KeyFrame* reference, std::uint64_t frameIndex);
 
   // Good keyframes and points, ordered by id.
   std::vector<KeyFrame*> keyFrames() const;
+  // @{
+  // Good map points, ordered by id, and the counts of good keyframes and points.
   std::vector<MapPoint*> mapPoints() const;
   std::size_t keyFrameCount() const;
   std::size_t mapPointCount() const;
+  // @}
+  // @{
+  // A keyframe or point by id (null beyond the last), and how many were ever created.
   KeyFrame* keyFrame(KeyFrameId id) const { return id < keyFrames_.size() ? keyFrames_[id].get() : nullptr; }
   MapPoint* mapPoint(MapPointId id) const { return id < points_.size() ? points_[id].get() : nullptr; }
   std::size_t createdKeyFrames() const { return keyFrames_.size(); }
   std::size_t createdMapPoints() const { return points_.size(); }
+  // @}
 
   // The first keyframe (the gauge of full BA and the root of the spanning tree).
   KeyFrame* origin() const { return keyFrames_.empty() ? nullptr : keyFrames_.front().get(); }

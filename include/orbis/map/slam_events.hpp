@@ -14,15 +14,21 @@
 
 namespace orbis {
 
+// Tracking's state after a frame.
 enum class TrackingState { NotInitialised, Ok, Lost };
+// "not-initialised", "ok" or "lost".
 const char* toString(TrackingState s);
 
 // What became of one keypoint of the last frame: matched to a map point, the seed of a new map
 // point (a new keyframe's or the first map's), rejected by motion-only BA, or left unmatched.
 enum class KeypointState : std::uint8_t { Unmatched, Matched, New, Outlier };
 
+// A loop closure, as reports list it.
 struct LoopClosureEvent {
+  // @{
+  // The current keyframe and the keyframe it closed the loop with.
   KeyFrameId current = 0, loop = 0;
+  // @}
   std::uint64_t frameIndex = 0;  // frame the current keyframe was made from
   int inliers = 0;               // matched points after the projection search
   // The similarity's scale: the current keyframe's map scale over the loop keyframe's, i.e. the

@@ -32,9 +32,11 @@
 
 namespace orbis {
 
+// How the system runs.
 struct SlamOptions {
   bool deterministic = false;     // inline stages in a fixed order (the tests use it)
   bool localisationOnly = false;  // tracking only, against the existing map (§III-F)
+  // Whether loops are closed.
   bool loopClosing = true;
   double fps = 30;                // frame rate: the keyframe rule's "max frames" (ORB-SLAM2)
   // Frames come from a live camera at fps (orbis run --realtime): threaded monocular tracking
@@ -51,13 +53,20 @@ struct SlamOptions {
   double newMapAfterLostSeconds = 0.3;
 };
 
+// What a run has done so far.
 struct SlamStats {
+  // @{
+  // Frames seen, tracked and lost; keyframes and map points in the map.
   std::size_t frames = 0, tracked = 0, lost = 0, keyFrames = 0, mapPoints = 0;
+  // @}
+  // Loops closed.
   std::size_t loopClosures = 0;
+  // @{
   // The frame the map started on (monocular: the second view of the accepted pair), and why the
   // frames before it did not start it (Tracker::initialisationWaits: reason -> frames).
   std::optional<std::uint64_t> initialisedAtFrame;
   std::map<std::string, std::size_t> initialisationWaits;
+  // @}
   std::size_t maps = 1, mapMerges = 0;  // maps ever opened in the atlas, merges done
 };
 
@@ -66,8 +75,10 @@ struct SlamStats {
 template <SensorConfiguration Sensor>
 class SlamCore {
  public:
+  // The sensor's camera model.
   using Camera = typename Sensor::Camera;
 
+  // A core for camera with the vocabulary; starts the threads unless deterministic.
   SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options);
   ~SlamCore();
   SlamCore(const SlamCore&) = delete;
@@ -77,6 +88,7 @@ class SlamCore {
   // frame observer, if one is set.
   TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp, double extractionMs = 0,
                     const cv::Mat& image = cv::Mat());
+  // Finishes queued work and joins the threads; the results stay readable.
   void shutdown();
 
   Trajectory trajectory() const;          // every tracked frame, camera-to-world
@@ -88,13 +100,17 @@ class SlamCore {
   std::uint32_t activeMapId() const;
   std::vector<MapMergeEvent> merges() const;
   Trajectory keyFrameTrajectory() const;  // every good keyframe, camera-to-world
+  // @{
+  // The map's points, the counters, the tracking state, and localisation-only mode.
   std::vector<Eigen::Vector3f> mapPointCloud() const;
   SlamStats stats() const;
   TrackingState state() const { return tracker_->state(); }
   void setLocalisationOnly(bool on);
+  // @}
   // Called after every frame on the tracking thread (slam_observer.hpp); set before tracking
   // starts, empty to remove. Without one, track() does no extra work.
   void setFrameObserver(FrameObserver observer);
+  // Whether a frame observer is set.
   bool observesFrames() const { return static_cast<bool>(frameObserver_); }
   // The map, loop closures and trajectory copied under the map mutex; callable from any thread.
   MapSnapshot mapSnapshot() const;
@@ -104,17 +120,23 @@ class SlamCore {
   // The file records whether the map's scale is metric (Sensor::kMetricScale); loadMap returns
   // the file's header.
   void saveMap(const std::filesystem::path& file);
+  // Loads a map file into a core that has not tracked yet; returns the file's header.
   MapFileInfo loadMap(const std::filesystem::path& file);
+  // The sensor's kind.
   static constexpr SensorKind sensorKind() { return Sensor::kKind; }
   // Relocalisation attempts and successes; keyframes loaded from a map file.
   RelocalisationStats relocalisationStats() const;
+  // Keyframes loaded from a map file.
   std::size_t loadedKeyFrames() const { return loadedKeyFrames_; }
 
+  // @{
+  // The map, the timer and the camera.
   Map& map() { return map_; }
   const Map& map() const { return map_; }
   StageTimer& timer() { return timer_; }
   const StageTimer& timer() const { return timer_; }
   const Camera& camera() const { return camera_; }
+  // @}
   // What the map file records of the camera.
   const MapIntrinsics& intrinsics() const { return intrinsics_; }
   // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode).

@@ -41,10 +41,12 @@ namespace orbis {
 
 
 
+// Tracking's thresholds (ORB-SLAM2's unless noted).
 struct TrackerOptions {
   int closeTrackedThreshold = 100;   // τt: fewer tracked close points than this …
   int closeCreatableThreshold = 70;  // τc: … and at least this many creatable ones → keyframe
   int maxFramesBetweenKeyFrames = 30;  // the camera's fps, as ORB-SLAM2
+  // Frames a new keyframe must wait after the last (0: none).
   int minFramesBetweenKeyFrames = 0;
   int minBootstrapFeatures = 500;      // keypoints needed to start the map (ORB-SLAM2)
   int bowLevelsUp = 4;                 // vocabulary level of the FeatureVector grouping
@@ -63,10 +65,13 @@ struct TrackerOptions {
   double newMapAfterLostSeconds = 0.3;
 };
 
+// What tracking made of a frame.
 struct TrackResult {
+  // Ok, Lost or NotInitialised.
   TrackingState state = TrackingState::NotInitialised;
   SE3d Tcw;              // valid when state == Ok
   int inliers = 0;       // matches to map points after motion-only BA
+  // Whether the frame became a keyframe.
   bool newKeyFrame = false;
   bool newMap = false;   // the frame opened a new map of the atlas (after a loss)
   std::uint32_t mapId = 0;  // the map of the atlas it was tracked in
@@ -75,9 +80,12 @@ struct TrackResult {
 
 // A tracked frame, stored relative to its reference keyframe.
 struct TrackedFrame {
+  // @{
+  // Frame index, seconds and the reference keyframe.
   std::uint64_t index;
   double timestamp;
   KeyFrame* reference;
+  // @}
   SE3d Tcr;  // camera-from-reference-keyframe
   std::uint32_t mapId = 0;  // the map of the atlas it was tracked in (its reference's map moves on merges)
 };
@@ -85,17 +93,25 @@ struct TrackedFrame {
 // Camera-from-world of a tracked frame through its (possibly since culled) reference keyframe.
 SE3d worldPoseOf(const TrackedFrame& f);
 
+// Tracking (§III-B/§V): motion model or reference keyframe, then the local map; decides keyframes
+// and relocalises when lost.
 template <SensorConfiguration Sensor>
 class Tracker {
  public:
+  // @{
+  // The sensor's camera model and frame type.
   using Camera = typename Sensor::Camera;
   using FrameT = Frame<Camera>;
+  // @}
 
+  // Tracks against map, handing keyframes to mapper.
   Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMappingControl* mapper, TrackerOptions options,
           StageTimer* timer = nullptr);
 
+  // Tracks one frame.
   TrackResult track(FrameT frame);
 
+  // The state after the last frame.
   TrackingState state() const { return state_; }
   // Why the last monocular initialisation attempt was refused (None before any attempt).
   TwoViewRefusal initialisationRefusal() const { return initialisationRefusal_; }
@@ -103,10 +119,14 @@ class Tracker {
   // reasons: "too few keypoints" (no reference frame: a textureless or blank view), "new
   // reference frame", or a TwoViewRefusal's name ("too few matches", "low parallax", ...).
   const std::map<std::string, std::size_t>& initialisationWaits() const { return initialisationWaits_; }
+  // @{
+  // Localisation-only mode (no keyframes).
   void setLocalisationOnly(bool on) { options_.localisationOnly = on; }
   bool localisationOnly() const { return options_.localisationOnly; }
+  // @}
   // Every tracked frame, by index. Read with the map mutex held (poses move with the map).
   const std::vector<TrackedFrame>& trackedFrames() const { return tracked_; }
+  // World pose of a tracked frame.
   static SE3d worldPose(const TrackedFrame& f) { return worldPoseOf(f); }
   // Relocalisation hook (loop module): given the frame, returns true and sets its pose/matches
   // when it found itself in the map again.
@@ -117,6 +137,7 @@ class Tracker {
   void setRecordKeypointStates(bool on) { recordKeypointStates_ = on; }
   // The last frame's keypoint states (empty unless recording) and its local map. Tracking thread.
   const std::vector<KeypointState>& keypointStates() const { return keypointStates_; }
+  // The last frame's local map.
   const std::vector<MapPoint*>& localMapPoints() const { return localPoints_; }
 
  private:
