@@ -9,6 +9,9 @@
 // (no Camera.bf: mono; Camera.bf and DepthMapFactor: rgbd; Camera.bf only: stereo). The camera
 // is then one alternative of a std::variant; code past this boundary dispatches once with
 // std::visit and runs on the concrete, compile-time camera type.
+// settingsKeys() lists every key load() reads (and load() reads no other), so tools that check
+// keys — `orbis settings-keys`, orbis.settings_keys() in Python, orbis.sweep's study files — share
+// one list with the reader. Keys a file has beyond it (ORB-SLAM2's Viewer.*) are ignored.
 // Every missing or malformed key (wrong type, non-positive focal length, ...) throws
 // orbis::Error naming the file and the key; an unreadable file names the file (and the line).
 #pragma once
@@ -16,6 +19,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <variant>
 
@@ -78,5 +82,16 @@ struct Settings {
 
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
+
+// A settings key load() reads: its name, its kind of value ("number", "whole number", "text" or
+// "matrix") and what it sets, in a few words.
+struct SettingsKey {
+  std::string_view name;
+  std::string_view type;
+  std::string_view meaning;
+};
+
+// Every key load() reads, in the order of ORB-SLAM2's files.
+std::span<const SettingsKey> settingsKeys();
 
 }  // namespace orbis

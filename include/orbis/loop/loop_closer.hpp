@@ -22,6 +22,12 @@
 // mode; its result is merged under the map lock with local mapping paused: optimised keyframes
 // take their new poses, keyframes created meanwhile follow their spanning-tree parent, points
 // created meanwhile follow their reference keyframe.
+// The atlas (issue 32): candidates in another map of the atlas than the keyframe's are merge
+// candidates, kept by the same consistency rule in their own groups and verified by the same
+// transform; a merge (loop_merge_impl.hpp) moves the smaller map into the other's frame,
+// relabels it, then fuses, optimises the essential graph, runs a welding BA around the seam and
+// full BA, as a loop does. Loops and merges stay within one map; full BA and the essential graph
+// cover the keyframe's map only.
 // Threaded: a worker consumes the queue. Deterministic: nothing runs until runUntilIdle(), which
 // does everything (full BA included) on the caller's thread, so results are bit-identical.
 // Each step holds Map::mutex(); the essential graph and full BA solve on copies outside it.
@@ -69,6 +75,9 @@ struct LoopCloserOptions {
   bool fullBundleAdjustment = true;
   int fullBundleAdjustmentIterations = 10;
   // @}
+  // Merging maps of the atlas: on, and the active map's keyframes a merge needs.
+  bool mergeMaps = true;
+  int mergeMinKeyFrames = 5;
   // Receives "loop closed: ..." lines; null prints them to stderr.
   std::function<void(const std::string&)> log;
 };
@@ -102,6 +111,7 @@ class LoopCloser {
 
   // The loops closed so far, in order.
   std::vector<LoopClosureEvent> closures() const;
+  std::vector<MapMergeEvent> merges() const;
 
  private:
   struct ConsistentGroup {
@@ -120,7 +130,10 @@ class LoopCloser {
   bool processOne();
   // Holding the map mutex:
   void dropBadKeyFrames();
-  std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf);
+  // Loop candidates (same map), and in mergeCandidates those of other maps of the atlas.
+  std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf, std::vector<KeyFrame*>& mergeCandidates);
+  // ORB-SLAM's consistency check of candidates against the previous keyframes' groups.
+  std::vector<KeyFrame*> keepConsistent(const std::vector<KeyFrame*>& candidates, std::vector<ConsistentGroup>& groups);
   bool computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out);
   // One candidate's transform from its bag-of-words matches (ORB-SLAM's ComputeSim3): RANSAC,
   // guided matching both ways through its result, two-way refinement; SE(3) or Sim(3) by the
@@ -128,13 +141,27 @@ class LoopCloser {
   bool loopTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches, LoopCandidate& out);
   // Takes the map mutex itself (pauses local mapping first):
   void correctLoop(KeyFrame* kf, LoopCandidate& loop);
+  // The map-merge counterpart (loop_merge_impl.hpp).
+  void mergeMaps(KeyFrame* kf, LoopCandidate& loop);
+  // Holding the map mutex: moves map `moved` into the frame of `kept` (x_kept = S·x_moved).
+  void moveMap(std::uint32_t moved, const Correction& S);
+
   using PoseMap = std::map<KeyFrame*, SE3d, ById>;
   using LinkMap = std::map<KeyFrame*, std::set<KeyFrame*, ById>, ById>;
   using CorrectionMap = std::map<KeyFrame*, Correction, ById>;
   using PointCorrectors = std::map<MapPoint*, KeyFrame*, ById>;
+  struct Fusion {
+    PoseMap nonCorrected;
+    CorrectionMap corrected;
+    LinkMap loopLinks;
+    PointCorrectors correctedBy;
+  };
+  // The loop's correction of the current keyframe's neighbourhood, fusion and links (the part
+  // correctLoop and mergeMaps share); takes the lock. Returns the points fused.
+  int fuseAcrossLoop(KeyFrame* kf, LoopCandidate& loop, Fusion& fusion);
   void optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected, const CorrectionMap& corrected,
                               const LinkMap& loopLinks, const PointCorrectors& correctedBy);
-  void startFullBundleAdjustment();
+  void startFullBundleAdjustment(std::uint32_t mapId);
   void runFullBundleAdjustment();
   void stopFullBundleAdjustment();
   void pauseMapping();
@@ -152,15 +179,18 @@ class LoopCloser {
 
   std::vector<KeyFrame*> indexed_;  // keyframes in the database (loop thread only)
   std::vector<ConsistentGroup> consistentGroups_;
+  std::vector<ConsistentGroup> mergeGroups_;
   KeyFrameId lastLoopKeyFrame_ = 0;
   bool anyLoop_ = false;
 
   mutable std::mutex eventsMutex_;
   std::vector<LoopClosureEvent> events_;
+  std::vector<MapMergeEvent> merges_;
 
   std::thread fullBaThread_;
   std::atomic<bool> abortFullBa_{false};
   std::atomic<bool> fullBaRunning_{false};
+  std::uint32_t fullBaMap_ = 0;  // the map the running full BA optimises
 
   QueueWorker<KeyFrame*> worker_;  // last: its thread stops before the state it serves goes
 };
@@ -169,6 +199,7 @@ class LoopCloser {
 
 #include "orbis/loop/loop_closer_impl.hpp"
 #include "orbis/loop/loop_correction_impl.hpp"
+#include "orbis/loop/loop_merge_impl.hpp"
 
 namespace orbis {
 extern template class LoopCloser<Stereo>;

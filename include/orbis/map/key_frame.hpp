@@ -150,6 +150,17 @@ class KeyFrame {
   // does) and detaches its map points. Returns false when it is protected or the root.
   bool setBad();
 
+  // ---- the atlas (map mutex held) --------------------------------------------------------
+  // The map of the atlas it belongs to (map.hpp); changes when its map is merged into another.
+  std::uint32_t mapId() const { return mapId_; }
+  void setMapId(std::uint32_t id) { mapId_ = id; }
+  // The first keyframe of its map: never culled. A gauge is a root BA keeps fixed; a root stops
+  // being one when its map is merged into another (that map's root holds the gauge).
+  bool isMapRoot() const { return mapRoot_; }
+  void setMapRoot(bool root) { mapRoot_ = root; gauge_ = root; }
+  bool isGauge() const { return gauge_; }
+  void setGauge(bool gauge) { gauge_ = gauge && mapRoot_; }
+
   // Relative pose to the parent recorded when the keyframe went bad, so trajectories can still
   // express frames referenced to it.
   const SE3d& poseRelativeToParent() const { return Tcp_; }
@@ -181,6 +192,8 @@ class KeyFrame {
   std::set<KeyFrame*, ById> loopEdges_;
   bool protected_ = false;
   bool bad_ = false;
+  std::uint32_t mapId_ = 0;
+  bool mapRoot_ = false, gauge_ = false;
 };
 
 }  // namespace orbis

@@ -6,7 +6,7 @@
 // the χ² outliers, which are then removed from the map. It copies the problem out of the map
 // under Map::mutex(), solves outside it (abortable through `abort`) and writes back under the
 // lock, skipping objects that went bad meanwhile. fullBundleAdjustment does the same over every
-// keyframe and point, the origin fixed, and returns the optimised values without writing them:
+// keyframe and point of one map of the atlas, its root fixed, and returns the optimised values without writing them:
 // the loop closer merges them through the spanning tree. Both run on the sensor's camera model and
 // robust kernel (callers pass Sensor::Camera and Sensor::RobustKernel): depth observations of an RGB-D sensor as
 // a whitened disparity, of a stereo pair as (uL, v, uR). Bodies: map_bundle_adjustment_impl.hpp.
@@ -58,7 +58,7 @@ struct FullBundleAdjustmentResult {
 // Full BA over every keyframe and point, the first keyframe fixed.
 template <optim::RobustKernel Kernel, CameraModel Camera>
 FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
-                                                std::atomic<bool>* abort);
+                                                std::atomic<bool>* abort, std::uint32_t mapId = 0);
 
 }  // namespace orbis
 

@@ -3,8 +3,9 @@
 // Contract: runDataset reads the sequence frame by frame through a DatasetReader, picks the
 // compile-time sensor configuration once from the dataset's sensor (Slam<Stereo>, Slam<Rgbd> or
 // Slam<Monocular>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
-// camera-to-world, every tracked frame), keyframes.txt (TUM), report.json (frame counts,
-// keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE of all frames and
+// camera-to-world, every tracked frame), trajectory_maps.txt (per line of it: timestamp, the
+// map it was tracked in, the map holding it now), keyframes.txt (TUM), report.json (frame counts,
+// keyframes, map points, the atlas's maps and merges, per-stage timing in ms: mean/median/p95, and the ATE of all frames and
 // of the keyframes when the dataset has ground truth, Sim(3)-aligned for monocular, else SE(3)), map.ply (map points) and overview.png (top view); for RGB-D, optionally a
 // dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
 // A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
@@ -52,6 +53,10 @@ struct RunOptions {
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
   SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned
   bool stats = false;  // diagnosis: outDir/stats.jsonl, one line per frame and per keyframe (StageTimer events)
+  // The atlas (docs/guide/atlas.md): off keeps ORB-SLAM2's single map; when to open a new map.
+  bool atlas = true;
+  int newMapAfterLostFrames = 10;
+  double newMapAfterLostSeconds = 0.3;
 };
 
 // What a run did: its counters, timing, accuracy and warnings (report.json).
@@ -85,6 +90,11 @@ struct RunReport {
   // @}
   // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.
   std::vector<LoopClosureEvent> loopClosures;
+  // The atlas: every map opened (report.json "maps"), the merges in order, and per tracked frame
+  // the map it was tracked in (trajectory_maps.txt).
+  std::vector<AtlasMapInfo> maps;
+  std::vector<MapMergeEvent> merges;
+  std::vector<std::uint32_t> frameMaps;
 };
 
 // Runs SLAM over the whole sequence and writes trajectory.txt, keyframes.txt, report.json, map.ply

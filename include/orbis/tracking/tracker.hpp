@@ -56,6 +56,13 @@ struct TrackerOptions {
   int minInitialisationMatches = 100;    // windowed matches below this drop the reference
   float initialisationWindow = 100;      // px around the previous match (ORB-SLAM's)
   unsigned initialisationSeed = 5489;    // the two-view RANSAC's generator (deterministic runs)
+  // The atlas (issue 32): when relocalisation has failed on at least newMapAfterLostFrames frames
+  // that could start a map, spanning at least newMapAfterLostSeconds, a new map is opened (the
+  // old ones stay): at once for metric sensors, by two-view initialisation for monocular. Off:
+  // ORB-SLAM2's single map, lost until relocalised.
+  bool atlas = true;
+  int newMapAfterLostFrames = 10;
+  double newMapAfterLostSeconds = 0.3;
 };
 
 // What tracking made of a frame.
@@ -66,6 +73,8 @@ struct TrackResult {
   int inliers = 0;       // matches to map points after motion-only BA
   // Whether the frame became a keyframe.
   bool newKeyFrame = false;
+  bool newMap = false;   // the frame opened a new map of the atlas (after a loss)
+  std::uint32_t mapId = 0;  // the map of the atlas it was tracked in
 };
 
 
@@ -78,6 +87,7 @@ struct TrackedFrame {
   KeyFrame* reference;
   // @}
   SE3d Tcr;  // camera-from-reference-keyframe
+  std::uint32_t mapId = 0;  // the map of the atlas it was tracked in (its reference's map moves on merges)
 };
 
 // Camera-from-world of a tracked frame through its (possibly since culled) reference keyframe.
@@ -143,6 +153,10 @@ class Tracker {
     requires(!Sensor::kMetricScale);
   void startMap(KeyFrame* first, KeyFrame* second, FrameT& f)
     requires(!Sensor::kMetricScale);
+  // The atlas: counts a lost frame that could start a map; true when a new map is due.
+  bool newMapDue();
+  // Opens a new map after a loss and starts it from `f` where the sensor can (metric: at once).
+  bool startNewMapAfterLoss(FrameT& f);
   bool trackReferenceKeyFrame();
   // Projects the last frame's matches through `motion` (current from last) and optimises.
   bool trackWithMotionModel(const SE3d& motion);
@@ -188,6 +202,9 @@ class Tracker {
   std::vector<KeypointState> keypointStates_;
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
   std::vector<TrackedFrame> tracked_;
+  int lostFramesWithView_ = 0;  // lost frames since the last tracked one that could start a map
+  double lostSince_ = 0;        // timestamp of the first of them
+  std::uint64_t mergesSeen_ = 0;  // Map::mergeCount() when the last frame was tracked
   mutable std::vector<std::pair<std::string, double>> diagnostics_;
 
   // Monocular initialisation: the reference frame, where its keypoints were last matched.

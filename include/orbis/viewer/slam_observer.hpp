@@ -59,6 +59,7 @@ struct KeyFrameSnapshot {
   SE3d Twc;
   // @}
   std::int64_t parent = -1;  // spanning tree; -1 at the root
+  std::uint32_t mapId = 0;   // its map of the atlas (the viewer colours each map)
   // @{
   // Graph edges.
   std::vector<KeyFrameId> covisibles, loopEdges;  // covisibles: weight >= kStrongCovisibility
@@ -84,6 +85,7 @@ struct MapSnapshot {
   std::vector<MapPointSnapshot> points;
   std::vector<LoopClosureEvent> loopClosures;
   // @}
+  std::vector<MapMergeEvent> merges;  // maps of the atlas merged, in order
   std::vector<Eigen::Vector3f> trajectory;  // camera centres of the tracked frames
   // Frames tracked.
   std::size_t frames = 0;
