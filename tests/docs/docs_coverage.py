@@ -7,13 +7,15 @@
 Commands and options come from the program itself (`orbis --help`, `orbis CMD --help`, and
 `orbis CMD ACTION --help` for commands with actions), so a new option is checked the day it is
 added. An option must appear in a page under docs/ that also names its command (`orbis CMD`).
-Settings keys come from the sources that read YAML with YamlReader (src/camera/yaml_reader.hpp):
+Settings keys come from `orbis settings-keys --json` (the library's list of what the settings
+reader accepts) where the program has that command, and from the sources that read YAML with YamlReader (src/camera/yaml_reader.hpp):
 the literal keys of their reads (`yaml.real("Camera.fx")`, `positive(yaml, "Camera.fy")`, ...),
 and a prefix passed to a block reader combined with the keys read under it (`LEFT.` + `K`). Keys
 read by a settings reader (a source whose name has "settings") must be in the settings reference,
 docs/guide/settings.md; keys of other YAML files (EuRoC's sensor.yaml) anywhere under docs/.
 Exit 0 when everything is covered; 1 with one line per gap, naming it and where to document it.
 """
+import json
 import pathlib
 import re
 import subprocess
@@ -113,6 +115,12 @@ def main():
                 gaps.append(f'option {option} of `{name}` is documented {where} '
                             f'(document it in the guide that covers `{name}`, e.g. docs/guide/commands.md)')
     keys = settings_keys(source)
+    # The library's own list of the keys it reads (`orbis settings-keys`), where the program has it.
+    if any(words == ['settings-keys'] for words, _ in table):
+        listed = subprocess.run([orbis, 'settings-keys', '--json'], capture_output=True, text=True, timeout=60)
+        for entry in json.loads(listed.stdout):
+            keys.append((entry['name'], source / 'src' / 'io' / 'settings.cpp'))
+        keys = sorted(set(keys))
     if not keys:
         gaps.append('no settings key found in the sources: the key scan no longer matches the readers')
     ref_text = reference.read_text(encoding='utf-8') if reference.exists() else ''
