@@ -1,101 +1,63 @@
 #!/usr/bin/env python3
 """One-command accuracy report: every real slice and the rendered loops, deterministic and threaded.
 
-For each sequence: deterministic runs at three feature budgets (0.9x, 1x, 1.1x the settings' own;
-a single deterministic run moves by several percent with any change, so the geometric mean of the
-three is the figure to compare) and N threaded runs at the settings' budget, run one at a time
-(as a user runs it: the mapping thread gets the other core). Reported per sequence: ATE (SE(3),
-every tracked frame), RPE (1 frame, translation), keyframes, map points, tracked frames, the
-threaded median and spread, and the ratio to ORB-SLAM2's figure where there is one (issue 18:
-ORB-SLAM2 built on the same machine, median of three runs). Writes WORK/results.json,
-WORK/report.md and WORK/ratios.png; with --baseline OLD/results.json the table and the plot show
-both runs side by side.
+The runs are the study benchmarks/studies/accuracy.yaml, executed by orbis.sweep (a local Dask
+cluster by default, resumable; docs/guide/sweep.md): deterministic runs at three feature budgets
+(0.9x, 1x, 1.1x the settings' own; a single deterministic run moves by several percent with any
+change, so the geometric mean of the three is the figure to compare) and N threaded runs at the
+settings' budget. This script only turns the sweep's rows into the report: per sequence ATE
+(SE(3), every tracked frame), RPE (1 frame, translation), keyframes, map points, tracked frames,
+the threaded median and spread, and the ratio to ORB-SLAM2's figure where the study gives one
+(issue 18: ORB-SLAM2 built on the same machine, median of three runs). Writes WORK/results.json,
+WORK/report.md and WORK/ratios.png beside the sweep's own table (WORK/results.csv, summary.md,
+plots/); with --baseline OLD/results.json the table and the plot show both runs side by side.
 
     benchmarks/eval_accuracy.sh [--label L] [--baseline OLD/results.json] [--threaded-runs N]
+                                [--workers N | --scheduler tcp://HOST:8786 | --serial] [--max-frames N]
 Environment: ORBIS (the program, default build/release/orbis), ORBIS_DATA (default
-../shared/datasets), WORK (scratch, default /tmp/orbis_eval).
+../shared/datasets), WORK (the study folder, default /tmp/orbis_eval; runs resume from it).
 """
 import argparse
-import concurrent.futures as cf
 import json
 import math
 import os
-import re
-import shutil
 import statistics
 import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ORBIS = os.environ.get("ORBIS", os.path.join(ROOT, "build/release/orbis"))
-DATA = os.environ.get("ORBIS_DATA", os.path.join(ROOT, "../shared/datasets"))
 WORK = os.environ.get("WORK", "/tmp/orbis_eval")
-SETTINGS = os.path.join(ROOT, "examples/settings")
-
-# ORB-SLAM2 on this machine (issue 18): SE(3) ATE of every tracked frame, median of three, metres.
-REFERENCE = {"teddy": 6.96e-3, "euroc": 0.83e-3, "kitti06": 46.5e-3, "kitti0102": 0.702}
+STUDY = os.path.join(ROOT, "benchmarks/studies/accuracy.yaml")
+BUDGETS = {"det0.9": "0.9", "det1.0": "1.0", "det1.1": "1.1"}
 
 
-def synth(name, *args):
-    folder = os.path.join(WORK, name)
-    if not os.path.exists(os.path.join(folder, "settings.yaml")):
-        subprocess.run([ORBIS, "synth", folder, "--frames", "300", "--extra", "75", "--width", "320", "--height",
-                        "240", "--fx", "250", "--noise", "4", "--threads", "2", *args],
-                       check=True, stdout=subprocess.DEVNULL)
-    return folder
+def run_all(args):
+    """The sweep's rows in this report's layout: per sequence, det runs by budget and threaded runs."""
+    from orbis import sweep
 
+    def threaded_runs(study):
+        for variant in study["variants"]:
+            if variant["name"] == "thr":
+                variant["repeats"] = args.threaded_runs
 
-def sequences():
-    d = DATA
-    euroc_gt = "mav0/state_groundtruth_estimate0/data.csv"
-    rgbd = synth("synth_rgbd", "--seed", "21")
-    rgbd_noisy = synth("synth_rgbd_depthnoise", "--seed", "21", "--depth-noise", "0.0014")
-    stereo = synth("synth_stereo", "--seed", "22", "--layout", "euroc")
-    k06 = f"{d}/kitti_06_first51"
-    k0102 = f"{d}/kitti_0102_first51"
-    # name: (dataset kind, path, settings, ground truth, extra eval arguments)
-    return {
-        "teddy": ("tum", f"{d}/tum_fr3_teddy_200", f"{SETTINGS}/TUM3.yaml", f"{d}/tum_fr3_teddy_200/groundtruth.txt", []),
-        "euroc": ("euroc", f"{d}/euroc_V1_01_easy_95", f"{SETTINGS}/EuRoC.yaml", f"{d}/euroc_V1_01_easy_95/{euroc_gt}", []),
-        "kitti06": ("kitti", k06, f"{SETTINGS}/KITTI04-12.yaml", f"{k06}/poses/06.txt",
-                    ["--gt-times", f"{k06}/sequences/06/times.txt"]),
-        "kitti0102": ("kitti", k0102, f"{SETTINGS}/KITTI00-02.yaml", f"{k0102}/poses/0102.txt",
-                      ["--gt-times", f"{k0102}/sequences/0102/times.txt"]),
-        "rgbd_loop": ("tum", rgbd, f"{rgbd}/settings.yaml", f"{rgbd}/groundtruth.txt", []),
-        "rgbd_loop_depthnoise": ("tum", rgbd_noisy, f"{rgbd_noisy}/settings.yaml", f"{rgbd_noisy}/groundtruth.txt", []),
-        "stereo_loop": ("euroc", stereo, f"{stereo}/settings.yaml", f"{stereo}/{euroc_gt}", []),
-    }
-
-
-def budget_settings(settings, factor, out):
-    text = open(settings).read()
-    n = int(re.search(r"^ORBextractor.nFeatures:\s*(\d+)", text, re.M).group(1))
-    n = int(round(n * factor / 10.0)) * 10
-    with open(out, "w") as f:
-        f.write(re.sub(r"^ORBextractor.nFeatures:.*$", f"ORBextractor.nFeatures: {n}", text, flags=re.M))
-    return out
-
-
-def run_one(name, seq, tag, deterministic, factor):
-    kind, path, settings, gt, eval_args = seq
-    out = os.path.join(WORK, f"out_{name}_{tag}")
-    shutil.rmtree(out, ignore_errors=True)
-    os.makedirs(out)
-    cfg = budget_settings(settings, factor, os.path.join(out, "settings.yaml"))
-    cmd = [ORBIS, "run", kind, path, "--settings", cfg, "--out", out] + (["--deterministic"] if deterministic else [])
-    subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=open(os.path.join(out, "stderr.txt"), "w"))
-    try:
-        r = json.load(open(os.path.join(out, "report.json")))
-    except (OSError, ValueError):
-        return {"ate": float("nan"), "rpe": float("nan"), "keyframes": 0, "map_points": 0, "tracked": 0, "frames": 0}
-    rpe = subprocess.run([ORBIS, "eval", "rpe", gt, os.path.join(out, "trajectory.txt"), "--json", *eval_args],
-                         capture_output=True, text=True)
-    try:
-        rpe_rmse = json.loads(rpe.stdout)["rmse"]
-    except ValueError:
-        rpe_rmse = float("nan")
-    return {"ate": r["ate"]["rmse"], "rpe": rpe_rmse, "keyframes": r["keyframes"], "map_points": r["map_points"],
-            "tracked": r["frames_tracked"], "frames": r["frames"]}
+    result = sweep.run(STUDY, WORK, scheduler=args.scheduler, workers=args.workers, serial=args.serial,
+                       program=os.environ.get("ORBIS"), max_frames=args.max_frames, edit=threaded_runs)
+    if result.interrupted:
+        sys.exit(130)
+    study, _, _ = sweep.load(STUDY, WORK, os.environ.get("ORBIS"), args.max_frames, edit=threaded_runs)
+    reference = {name: seq.reference["ate"] for name, seq in study.sequences.items() if "ate" in seq.reference}
+    results = {name: {"det": {}, "thr": []} for name in study.sequences}
+    for row in sorted(result.rows, key=lambda r: (r["variant"], r["repeat"])):
+        ok = row.get("status") == "ok"
+        run = {"ate": row["ate_rmse"] if ok else float("nan"), "rpe": row.get("rpe_rmse", float("nan")) if ok else float("nan"),
+               "keyframes": row.get("keyframes", 0) if ok else 0, "map_points": row.get("map_points", 0) if ok else 0,
+               "tracked": row.get("frames_tracked", 0) if ok else 0, "frames": row.get("frames", 0) if ok else 0}
+        run = {k: (float("nan") if v is None else v) for k, v in run.items()}
+        if row["variant"] in BUDGETS:
+            results[row["sequence"]]["det"][BUDGETS[row["variant"]]] = run
+        else:
+            results[row["sequence"]]["thr"].append(run)
+    return results, reference
 
 
 def gmean(values):
@@ -103,24 +65,7 @@ def gmean(values):
     return math.exp(sum(math.log(v) for v in values) / len(values)) if values and all(v > 0 for v in values) else float("nan")
 
 
-def run_all(threaded_runs):
-    seqs = sequences()
-    results = {name: {"det": {}, "thr": []} for name in seqs}
-    # Deterministic runs are single-threaded: two at a time on two cores.
-    with cf.ThreadPoolExecutor(max_workers=2) as pool:
-        jobs = {pool.submit(run_one, name, seq, f"det{f}", True, f): (name, f)
-                for name, seq in seqs.items() for f in (0.9, 1.0, 1.1)}
-        for job in cf.as_completed(jobs):
-            name, f = jobs[job]
-            results[name]["det"][str(f)] = job.result()
-    # Threaded runs one at a time, as a user runs them.
-    for k in range(threaded_runs):
-        for name, seq in seqs.items():
-            results[name]["thr"].append(run_one(name, seq, f"thr{k}", False, 1.0))
-    return results
-
-
-def summarise(results):
+def summarise(results, reference):
     rows = {}
     for name, r in results.items():
         det = [r["det"][k] for k in sorted(r["det"])]
@@ -138,9 +83,9 @@ def summarise(results):
             "thr_map_points": statistics.median([t["map_points"] for t in thr]),
             "tracked": f"{min(t['tracked'] for t in thr + det)}/{det[1]['frames']}",
         }
-        if name in REFERENCE:
-            rows[name]["ratio_thr"] = rows[name]["thr_ate_median"] / REFERENCE[name]
-            rows[name]["ratio_det"] = rows[name]["det_ate_gmean"] / REFERENCE[name]
+        if name in reference:
+            rows[name]["ratio_thr"] = rows[name]["thr_ate_median"] / reference[name]
+            rows[name]["ratio_det"] = rows[name]["det_ate_gmean"] / reference[name]
     return rows
 
 
@@ -212,14 +157,23 @@ def main():
     ap.add_argument("--baseline", help="results.json of an earlier report, shown side by side")
     ap.add_argument("--threaded-runs", type=int, default=3)
     ap.add_argument("--report-only", action="store_true", help="table and plot from WORK/results.json, no runs")
+    where = ap.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, help="local Dask cluster of N workers (default: one per core)")
+    where.add_argument("--scheduler", help="a running Dask scheduler, tcp://HOST:8786")
+    where.add_argument("--serial", action="store_true", help="the runs one after another, no Dask")
+    ap.add_argument("--max-frames", type=int, help="every run processes at most N frames (a quick look)")
     args = ap.parse_args()
     os.makedirs(WORK, exist_ok=True)
     if args.report_only:
         done = json.load(open(os.path.join(WORK, "results.json")))
         rows, args.label = done["rows"], done["label"]
     else:
-        results = run_all(args.threaded_runs)
-        rows = summarise(results)
+        from orbis.sweep import StudyError
+        try:
+            results, reference = run_all(args)
+        except StudyError as e:
+            sys.exit(f"eval_accuracy: error: {e}")
+        rows = summarise(results, reference)
         json.dump({"label": args.label, "rows": rows, "runs": results}, open(os.path.join(WORK, "results.json"), "w"), indent=1)
     base = base_label = None
     if args.baseline:

@@ -4,7 +4,8 @@ Contract: this package is the public face of the compiled extension ``orbis._orb
 re-exports the SLAM classes, settings, vocabulary, trajectory I/O and errors at the top level,
 and groups the rest by area: ``orbis.datasets`` (TUM / EuRoC / KITTI readers), ``orbis.eval``
 (ATE, RPE, KITTI metric, the same numbers as ``orbis eval``) and ``orbis.ba`` (BAL problems and
-the bundle-adjustment solver). Poses are 4 x 4 camera-to-world float64 matrices; trajectories
+the bundle-adjustment solver); ``orbis.sweep`` (studies of sequences x settings x repeats on a
+Dask cluster) is imported on demand. Poses are 4 x 4 camera-to-world float64 matrices; trajectories
 are (N, 8) float64 arrays of TUM rows ``t x y z qx qy qz qw``.
 
 Example::
@@ -35,6 +36,7 @@ from ._orbis import (
     calibrate,
     extract_orb,
     read_trajectory,
+    settings_keys,
     write_trajectory,
 )
 from . import ba, datasets, eval  # noqa: E402  (the submodules import the names above)
@@ -57,6 +59,7 @@ __all__ = [
     "extract_orb",
     "pose_matrices",
     "read_trajectory",
+    "settings_keys",
     "write_trajectory",
     "__version__",
 ]

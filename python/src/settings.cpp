@@ -124,6 +124,15 @@ void bindSettings(py::module_& m) {
       .def("__repr__", [](const Settings& s) {
         return "Settings(source='" + s.source.string() + "', sensor='" + std::string(toString(s.sensor)) + "')";
       });
+  m.def(
+      "settings_keys",
+      [] {
+        py::list keys;
+        for (const SettingsKey& k : settingsKeys())
+          keys.append(py::dict("name"_a = k.name, "type"_a = k.type, "meaning"_a = k.meaning));
+        return keys;
+      },
+      "Every settings key Settings.load reads, as dicts of name, type and meaning (`orbis settings-keys`).");
 }
 
 }  // namespace orbis::python

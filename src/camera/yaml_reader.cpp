@@ -1,6 +1,7 @@
 // Checked reads from YAML files of keys; see yaml_reader.hpp.
 #include "yaml_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -44,9 +45,19 @@ YamlReader::YamlReader(const std::filesystem::path& path, Header header) : path_
   if (!root_.IsMap()) throw fileError(path_, "expected a YAML map of keys at the top level");
 }
 
-bool YamlReader::has(const std::string& key) const { return static_cast<bool>(root_[key]); }
+void YamlReader::requireAccepted(const std::string& key) const {
+  if (!accepted_.empty() && std::find(accepted_.begin(), accepted_.end(), key) == accepted_.end())
+    throw std::logic_error("orbis: the reader of " + path_ + " looks up the key " + key +
+                           ", which is missing from its list of accepted keys (add it there)");
+}
+
+bool YamlReader::has(const std::string& key) const {
+  requireAccepted(key);
+  return static_cast<bool>(root_[key]);
+}
 
 YAML::Node YamlReader::node(const std::string& key) const {
+  requireAccepted(key);
   const YAML::Node n = root_[key];
   if (!n) throw error(key, "missing");
   return n;

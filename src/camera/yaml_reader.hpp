@@ -6,12 +6,16 @@
 // not used: it needs the header and hangs on some damaged files (found by fuzzing). With
 // Header::Required the "%YAML:1.0" line must be there, as ORB-SLAM2 needs it. Every failure —
 // missing file, unparseable text, missing key, wrong type, wrong length — throws orbis::Error
-// naming the file and the key (or the line, for parse errors).
+// naming the file and the key (or the line, for parse errors). A reader given a list of accepted
+// keys (acceptOnly) refuses, as a programming error, to look up any other: the settings reader
+// uses it so its published key list (orbis::settingsKeys) cannot fall behind what it reads.
 // Not installed: settings.cpp and the camera readers share it.
 #pragma once
 
 #include <filesystem>
 #include <optional>
+#include <span>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -28,6 +32,9 @@ class YamlReader {
   explicit YamlReader(const std::filesystem::path& path, Header header = Header::Required);
 
   const std::string& path() const { return path_; }
+  // From now on, looking up a key outside `keys` throws std::logic_error (a reader bug, not bad
+  // input); `keys` must outlive the reader.
+  void acceptOnly(std::span<const std::string_view> keys) { accepted_ = keys; }
   bool has(const std::string& key) const;
   Error error(const std::string& key, const std::string& what) const { return keyError(path_, key, what); }
 
@@ -48,9 +55,11 @@ class YamlReader {
   YAML::Node node(const std::string& key) const;  // throws when missing
   double number(const YAML::Node& n, const std::string& key) const;
   int wholeNumber(const YAML::Node& n, const std::string& key) const;
+  void requireAccepted(const std::string& key) const;
 
   std::string path_;
   YAML::Node root_;
+  std::span<const std::string_view> accepted_;  // empty: every key
 };
 
 }  // namespace orbis::detail

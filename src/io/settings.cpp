@@ -1,7 +1,9 @@
 // ORB-SLAM2 settings reader; see orbis/io/settings.hpp.
 #include "orbis/io/settings.hpp"
 
+#include <array>
 #include <cmath>
+#include <iterator>
 
 #include "../camera/yaml_reader.hpp"
 
@@ -10,6 +12,67 @@ namespace orbis {
 namespace {
 
 using detail::YamlReader;
+
+constexpr SettingsKey kSettingsKeys[] = {
+    {"Sensor", "text", "mono, stereo or rgbd (orbis; default: inferred from Camera.bf and DepthMapFactor)"},
+    {"Camera.fx", "number", "focal length in x, pixels"},
+    {"Camera.fy", "number", "focal length in y, pixels"},
+    {"Camera.cx", "number", "principal point x, pixels"},
+    {"Camera.cy", "number", "principal point y, pixels"},
+    {"Camera.k1", "number", "radial distortion k1 of the input images"},
+    {"Camera.k2", "number", "radial distortion k2"},
+    {"Camera.p1", "number", "tangential distortion p1"},
+    {"Camera.p2", "number", "tangential distortion p2"},
+    {"Camera.k3", "number", "radial distortion k3 (optional, default 0)"},
+    {"Camera.width", "whole number", "image width (optional: taken from the first image)"},
+    {"Camera.height", "whole number", "image height (optional: taken from the first image)"},
+    {"Camera.fps", "number", "frame rate (optional, 0 or absent: 30)"},
+    {"Camera.bf", "number", "stereo baseline times fx (stereo and rgbd)"},
+    {"Camera.RGB", "whole number", "1: colour images are RGB, 0: BGR"},
+    {"Camera.type", "text", "lens model: PinHole (default) or KannalaBrandt8 (fisheye, ORB-SLAM3)"},
+    {"Camera.k4", "number", "KannalaBrandt8: fisheye coefficient k4 (k1..k3 as Camera.k1..k3)"},
+    {"Camera.maxAngle", "number", "KannalaBrandt8: widest angle off axis the lens is trusted at, degrees (orbis, default 180)"},
+    {"Camera1.fx", "number", "ORB-SLAM3 layout (KannalaBrandt8): focal length in x, pixels"},
+    {"Camera1.fy", "number", "ORB-SLAM3 layout: focal length in y, pixels"},
+    {"Camera1.cx", "number", "ORB-SLAM3 layout: principal point x, pixels"},
+    {"Camera1.cy", "number", "ORB-SLAM3 layout: principal point y, pixels"},
+    {"Camera1.k1", "number", "ORB-SLAM3 layout: fisheye coefficient k1"},
+    {"Camera1.k2", "number", "ORB-SLAM3 layout: fisheye coefficient k2"},
+    {"Camera1.k3", "number", "ORB-SLAM3 layout: fisheye coefficient k3"},
+    {"Camera1.k4", "number", "ORB-SLAM3 layout: fisheye coefficient k4"},
+    {"System.seed", "whole number", "seed of every random choice of the system (orbis, default 0)"},
+    {"ThDepth", "number", "close/far depth threshold, in baselines (default 40)"},
+    {"DepthMapFactor", "number", "raw depth / factor = metres (rgbd)"},
+    {"DepthDisparitySigma", "number", "sigma of the depth sensor's virtual disparity, pixels (orbis, rgbd)"},
+    {"ORBextractor.nFeatures", "whole number", "features per image (the feature budget)"},
+    {"ORBextractor.scaleFactor", "number", "scale between pyramid levels (> 1)"},
+    {"ORBextractor.nLevels", "whole number", "pyramid levels"},
+    {"ORBextractor.iniThFAST", "whole number", "FAST threshold tried first"},
+    {"ORBextractor.minThFAST", "whole number", "FAST threshold where the first finds too few corners"},
+    {"ORBextractor.rightFeaturesFactor", "whole number", "right image's budget multiple (stereo, orbis)"},
+    {"LEFT.K", "matrix", "left camera: 3x3 intrinsics before rectification"},
+    {"LEFT.D", "matrix", "left camera: distortion k1 k2 p1 p2 [k3]"},
+    {"LEFT.R", "matrix", "left camera: 3x3 rectifying rotation"},
+    {"LEFT.P", "matrix", "left camera: 3x4 projection after rectification"},
+    {"LEFT.width", "whole number", "left camera: image width"},
+    {"LEFT.height", "whole number", "left camera: image height"},
+    {"RIGHT.K", "matrix", "right camera: 3x3 intrinsics before rectification"},
+    {"RIGHT.D", "matrix", "right camera: distortion k1 k2 p1 p2 [k3]"},
+    {"RIGHT.R", "matrix", "right camera: 3x3 rectifying rotation"},
+    {"RIGHT.P", "matrix", "right camera: 3x4 projection after rectification"},
+    {"RIGHT.width", "whole number", "right camera: image width"},
+    {"RIGHT.height", "whole number", "right camera: image height"},
+};
+
+// The names alone, for YamlReader::acceptOnly.
+std::span<const std::string_view> settingsKeyNames() {
+  static const auto names = [] {
+    std::array<std::string_view, std::size(kSettingsKeys)> n{};
+    for (std::size_t i = 0; i < n.size(); ++i) n[i] = kSettingsKeys[i].name;
+    return n;
+  }();
+  return names;
+}
 
 SensorKind chooseSensor(const YamlReader& yaml, std::optional<SensorKind> requested) {
   if (requested) return *requested;
@@ -117,7 +180,8 @@ RectificationBlock readBlock(const YamlReader& yaml, const std::string& prefix) 
 }
 
 Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKind> requested) {
-  const YamlReader yaml(file);
+  YamlReader yaml(file);
+  yaml.acceptOnly(settingsKeyNames());
   Settings s;
   s.source = file;
   s.sensor = chooseSensor(yaml, requested);
@@ -177,6 +241,8 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
 }
 
 }  // namespace
+
+std::span<const SettingsKey> settingsKeys() { return kSettingsKeys; }
 
 Settings Settings::load(const std::filesystem::path& file) { return loadSettings(file, std::nullopt); }
 

@@ -66,6 +66,36 @@ void writeEvents(const fs::path& file, const std::vector<StageEvent>& events) {
   }
 }
 
+// The atlas (docs/guide/atlas.md): maps with their frames, merges with their transform.
+void writeAtlas(JsonWriter& w, const RunReport& r) {
+  std::map<std::uint32_t, std::size_t> framesPerMap;
+  for (std::uint32_t m : r.frameMaps) ++framesPerMap[m];
+  w.key("maps").beginArray();
+  for (const AtlasMapInfo& m : r.maps) {
+    w.beginObject().field("id", std::size_t{m.id}).field("start_frame", m.startFrame).field("frames_tracked", framesPerMap[m.id]);
+    w.field("keyframes", m.keyFrames).field("map_points", m.mapPoints).field("active", m.active);
+    w.key("merged_into");
+    if (m.merged) w.value(std::size_t{m.mergedInto});
+    else w.null();
+    w.endObject();
+  }
+  w.endArray();
+  w.key("merges").beginArray();
+  for (const MapMergeEvent& e : r.merges) {
+    w.beginObject().field("frame", e.frameIndex).field("other_frame", e.otherFrameIndex);
+    w.field("current_keyframe", e.current).field("other_keyframe", e.other);
+    w.field("active_map", std::size_t{e.activeMap}).field("other_map", std::size_t{e.otherMap}).field("moved_map", std::size_t{e.movedMap});
+    w.field("kept_map", std::size_t{e.keptMap}).field("moved_keyframes", e.movedKeyFrames).field("moved_points", e.movedPoints);
+    w.field("inliers", e.inliers).field("fused_points", e.fusedPoints).field("scale", e.scale);
+    w.key("rotation_wxyz").beginArray();
+    for (int k = 0; k < 4; ++k) w.value(e.rotation[k]);
+    w.endArray().key("translation").beginArray();
+    for (int k = 0; k < 3; ++k) w.value(e.translation[k]);
+    w.endArray().field("ms", e.milliseconds).endObject();
+  }
+  w.endArray();
+}
+
 void writeReport(const fs::path& file, const RunReport& r) {
   JsonWriter w;
   w.beginObject();
@@ -108,6 +138,7 @@ void writeReport(const fs::path& file, const RunReport& r) {
     w.field("inliers", e.inliers).field("scale", e.scale).endObject();
   }
   w.endArray();
+  writeAtlas(w, r);
   // Repeated warnings folded (a few of each kind, then a count), as the program prints them.
   const std::vector<WarningKind> kinds = foldWarnings(r.warnings);
   w.key("warnings").beginArray();
@@ -190,6 +221,9 @@ void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbP
   slamOptions.loopClosing = options.loopClosing;
   slamOptions.fps = fps;
   slamOptions.liveCamera = options.realtime;
+  slamOptions.atlas = options.atlas;
+  slamOptions.newMapAfterLostFrames = options.newMapAfterLostFrames;
+  slamOptions.newMapAfterLostSeconds = options.newMapAfterLostSeconds;
   Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, vocabulary, slamOptions);
   slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {
@@ -268,12 +302,25 @@ void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbP
   report.stats = slam.stats();
   report.timing = slam.timer().summary();
   if (const auto* closer = slam.core().loopCloser()) report.loopClosures = closer->closures();
+  report.maps = slam.core().maps();
+  report.merges = slam.core().merges();
+  report.frameMaps = slam.core().trajectoryMaps();
+  const std::vector<std::uint32_t> frameMapsNow = slam.core().trajectoryMaps(true);
 
   fs::create_directories(options.outDir);
   const Trajectory trajectory = slam.trajectory();
   const Trajectory keyFrames = slam.keyFrameTrajectory();
   writeTrajectory(options.outDir / "trajectory.txt", trajectory, TrajectoryFormat::Tum);
   writeTrajectory(options.outDir / "keyframes.txt", keyFrames, TrajectoryFormat::Tum);
+  {
+    std::ofstream maps(options.outDir / "trajectory_maps.txt");
+    maps << "# timestamp map_tracked_in map_now\n";
+    char line[96];
+    for (std::size_t i = 0; i < trajectory.size() && i < report.frameMaps.size(); ++i) {
+      std::snprintf(line, sizeof line, "%.6f %u %u\n", trajectory[i].t, report.frameMaps[i], frameMapsNow[i]);
+      maps << line;
+    }
+  }
   auto cloud = slam.mapPointCloud();
   writePly(options.outDir / "map.ply", cloud);
 

@@ -15,6 +15,8 @@
 
 namespace orbis {
 
+// Reads one camera of an EuRoC sequence from its sensor.yaml as ASL publishes it (intrinsics,
+// radial-tangential distortion, T_BS); throws orbis::Error naming the file and key.
 CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml);
 
 }  // namespace orbis

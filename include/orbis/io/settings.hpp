@@ -15,6 +15,9 @@
 // (no Camera.bf: mono; Camera.bf and DepthMapFactor: rgbd; Camera.bf only: stereo). The camera
 // is then one alternative of a std::variant; code past this boundary dispatches once with
 // std::visit and runs on the concrete, compile-time camera type.
+// settingsKeys() lists every key load() reads (and load() reads no other), so tools that check
+// keys — `orbis settings-keys`, orbis.settings_keys() in Python, orbis.sweep's study files — share
+// one list with the reader. Keys a file has beyond it (ORB-SLAM2's Viewer.*) are ignored.
 // Every missing or malformed key (wrong type, non-positive focal length, ...) throws
 // orbis::Error naming the file and the key; an unreadable file names the file (and the line).
 #pragma once
@@ -22,6 +25,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <variant>
 
@@ -38,23 +42,34 @@ namespace orbis {
 // SensorKind, its names and their parser: orbis/camera/sensor_kind.hpp (shared with the dataset
 // readers and the command line).
 
+// The camera a settings file describes, by sensor: the one std::variant; code past it runs on the
+// concrete type.
 using CameraVariant =
     std::variant<PinholeCamera<double>, RectifiedStereoCamera<double>, RgbdCamera<double>, KannalaBrandtCamera<double>>;
 
+// ORB-SLAM2's LEFT./RIGHT. rectification blocks of a stereo settings file.
 struct StereoRectificationBlocks {
+  // @{
+  // The left and right camera's block.
   RectificationBlock left, right;
+  // @}
 
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
 
+// An ORB-SLAM2 settings file, read: the sensor, its camera and the extractor's parameters
+// (docs/guide/settings.md lists every key).
 struct Settings {
+  // The file read.
   std::filesystem::path source;
+  // The sensor chosen (argument, Sensor key, or inferred).
   SensorKind sensor = SensorKind::Monocular;
   // PinholeCamera for mono (KannalaBrandtCamera for a KannalaBrandt8 mono camera),
   // RectifiedStereoCamera for stereo, RgbdCamera for rgbd; stereo and
   // RGB-D carry baseline = Camera.bf / Camera.fx and closeDepth = ThDepth * baseline.
   CameraVariant camera;
   RadTanDistortion<double> distortion;  // of the input images (Camera.k1..k3); zero if rectified or fisheye
+  // The ORBextractor.* parameters.
   OrbParams orb;
   double fps = 30.0;           // Camera.fps (0 or absent: 30, as ORB-SLAM2)
   bool rgbOrder = true;        // Camera.RGB: colour images arrive as RGB (1) or BGR (0)
@@ -65,7 +80,10 @@ struct Settings {
   std::optional<StereoRectificationBlocks> rectification;  // LEFT./RIGHT. blocks, if present
   std::uint32_t seed = 0;      // System.seed: seeds every random choice of the system
 
+  // Reads file, choosing the sensor from its Sensor key or its keys; throws orbis::Error naming the
+  // file and key.
   static Settings load(const std::filesystem::path& file);
+  // Reads file as the given sensor.
   static Settings load(const std::filesystem::path& file, SensorKind sensor);
 
   // Remap tables from the LEFT./RIGHT. blocks; throws orbis::Error when the file has none.
@@ -73,5 +91,16 @@ struct Settings {
 
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
 };
+
+// A settings key load() reads: its name, its kind of value ("number", "whole number", "text" or
+// "matrix") and what it sets, in a few words.
+struct SettingsKey {
+  std::string_view name;
+  std::string_view type;
+  std::string_view meaning;
+};
+
+// Every key load() reads, in the order of ORB-SLAM2's files.
+std::span<const SettingsKey> settingsKeys();
 
 }  // namespace orbis

@@ -28,28 +28,38 @@
 
 namespace orbis::synth {
 
+// How frames are rendered.
 struct RenderOptions {
   int supersample = 2;   // rays per pixel along each axis
   double lodBias = 0.0;  // added to every mip level (positive: blurrier)
+  // Rendering threads.
   int threads = 1;
 };
 
+// A ray caster for axis-aligned textured rectangles, with mip-mapped, supersampled texture lookups.
 class Renderer {
  public:
+  // A renderer with these options.
   explicit Renderer(RenderOptions options = {}) : options_(options) {}
 
+  // Renders the grey image (and, when asked, the depth in metres) of scene through camera at
+  // cameraToWorld.
   void render(const Scene& scene, const PinholeCamera<double>& camera, const SE3d& cameraToWorld,
               cv::Mat& gray, cv::Mat* depth = nullptr);
   void render(const Scene& scene, const KannalaBrandtCamera<double>& camera, const SE3d& cameraToWorld,
               cv::Mat& gray, cv::Mat* depth = nullptr);
 
+  // The options.
   const RenderOptions& options() const { return options_; }
 
   // One rectangle as the hot loop sees it in the current frame.
   struct FrameRect {
+    // @{
+    // The rectangle's axis, in-plane axes, plane offset, bounds, texel scale and texture.
     int axis, u, v;
     double offset, lo0, lo1, hi0, hi1, invTexel, lodScale;
     const Texture* texture;
+    // @}
   };
 
  private:

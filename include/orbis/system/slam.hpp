@@ -23,12 +23,18 @@
 
 namespace orbis {
 
+// The SLAM system on a sensor: features by Sensor::FeatureBuilder, then SlamCore (tracking, local
+// mapping, loop closing).
 template <SensorConfiguration Sensor>
 class Slam {
  public:
+  // @{
+  // The sensor's camera model and input.
   using Camera = typename Sensor::Camera;
   using Input = typename Sensor::Input;
+  // @}
 
+  // A system for camera, with the extractor's parameters and the vocabulary.
   Slam(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
        SlamOptions options = {})
       : builder_(camera, orb), core_(camera, std::move(vocabulary), options) {}
@@ -40,6 +46,7 @@ class Slam {
     requires std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&, const Lens&>
       : builder_(camera, orb, lens), core_(camera, std::move(vocabulary), options) {}
 
+  // Extracts the input's features and tracks them; returns the state and, when tracked, the pose.
   TrackResult track(const Input& input) {
     std::shared_ptr<const FrameFeatures> features;
     double extractionMs = 0;
@@ -58,20 +65,32 @@ class Slam {
     return result;
   }
 
+  // Finishes queued mapping and loop-closing work and joins the threads; the results stay readable.
   void shutdown() { core_.shutdown(); }
+  // Every tracked frame's pose (camera to world).
   Trajectory trajectory() const { return core_.trajectory(); }
+  // Every good keyframe's pose (camera to world).
   Trajectory keyFrameTrajectory() const { return core_.keyFrameTrajectory(); }
+  // The map's points.
   std::vector<Eigen::Vector3f> mapPointCloud() const { return core_.mapPointCloud(); }
+  // Frames, tracked, lost, keyframes, points, loops and initialisation.
   SlamStats stats() const { return core_.stats(); }
+  // The state after the last frame.
   TrackingState state() const { return core_.state(); }
+  // Switches localisation-only mode on or off.
   void setLocalisationOnly(bool on) { core_.setLocalisationOnly(on); }
   // See SlamCore::setFrameObserver and mapSnapshot (slam_observer.hpp).
   void setFrameObserver(FrameObserver observer) { core_.setFrameObserver(std::move(observer)); }
+  // A copy of the map, loops and trajectory (any thread).
   MapSnapshot mapSnapshot() const { return core_.mapSnapshot(); }
+  // Per-stage timing.
   const StageTimer& timer() const { return core_.timer(); }
+  // @{
+  // The core, for what Slam does not forward (map files, the map itself): its pipeline sensor's.
   using Core = SlamCore<PipelineSensor<Sensor>>;
   Core& core() { return core_; }
   const Core& core() const { return core_; }
+  // @}
 
  private:
   // The image a frame observer is shown: the left one of a stereo pair.
