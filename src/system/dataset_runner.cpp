@@ -11,6 +11,7 @@
 #include "orbis/io/overview.hpp"
 #include "orbis/io/ply.hpp"
 #include "orbis/io/settings.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
 #include "orbis/util/progress.hpp"
@@ -166,6 +167,10 @@ template <>
 MonocularInput makeInput<Monocular>(const DatasetFrame& f) {
   return {f.timestamp, f.left};
 }
+template <>
+MonocularInput makeInput<MonocularFisheye>(const DatasetFrame& f) {
+  return {f.timestamp, f.left};
+}
 
 bool inputComplete(const StereoInput& in) { return !in.left.empty() && !in.right.empty(); }
 bool inputComplete(const RgbdInput& in) { return !in.image.empty() && !in.depth.empty(); }
@@ -173,8 +178,8 @@ bool inputComplete(const MonocularInput& in) { return !in.image.empty(); }
 
 // A monocular camera's images may still carry lens distortion; the stereo and RGB-D inputs the
 // runner feeds are rectified or undistorted.
-template <class Sensor>
-Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
+template <class Sensor, class Lens>
+Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& orb, const Lens& lens,
                       std::shared_ptr<const OrbVocabulary> vocabulary, const SlamOptions& options) {
   if constexpr (Sensor::kKind == SensorKind::Monocular) return Slam<Sensor>(camera, orb, lens, std::move(vocabulary), options);
   else return Slam<Sensor>(camera, orb, std::move(vocabulary), options);
@@ -206,8 +211,8 @@ class FramePacer {
   std::chrono::steady_clock::time_point firstFed_;
 };
 
-template <class Sensor>
-void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<double>& lens, const OrbParams& orb,
+template <class Sensor, class Lens>
+void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbParams& orb,
              double fps, DatasetReader& dataset, const RunOptions& options, RunReport& report) {
   auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
   SlamOptions slamOptions;
@@ -392,7 +397,18 @@ RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
     const Settings s = Settings::load(*options.settings, dataset.sensor());
     orb = s.orb;
     fps = s.fps;
-    camera = std::visit([](const auto& c) -> DatasetCamera { return c; }, s.camera);
+    if (const auto* fisheye = std::get_if<KannalaBrandtCamera<double>>(&s.camera)) {
+      // Settings pick the instantiation once: a monocular Kannala-Brandt lens (settings.hpp).
+      report.sensor = std::string(toString(dataset.sensor())) + " (fisheye)";
+      runWith<MonocularFisheye>(MonocularFisheye::planeOf(*fisheye), *fisheye, orb, fps, dataset, options, report);
+      return report;
+    }
+    camera = std::visit(
+        [](const auto& c) -> DatasetCamera {
+          if constexpr (std::is_same_v<std::decay_t<decltype(c)>, KannalaBrandtCamera<double>>) return c.centralPinhole();
+          else return c;
+        },
+        s.camera);
     lens = s.distortion;
   } else {
     camera = dataset.camera();

@@ -8,8 +8,13 @@
 // After rectification a scene point has the same row in both images and uR = uL - bf/Z.
 // Inconsistent input (different resolutions, a vertical or reversed pair) throws orbis::Error;
 // the source of the calibration is named by the caller (settings file, sensor.yaml).
+// A camera may instead carry a Kannala–Brandt fisheye lens (CameraCalibration::fisheye, k1..k4,
+// Kalibr's "equidistant"): a pair of them is rectified with OpenCV's fisheye functions to a
+// pinhole pair (balance 0: only valid pixels, the field of view a pinhole can hold).
 #pragma once
 
+#include <array>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -26,6 +31,7 @@ struct CameraCalibration {
   PinholeCamera<double> intrinsics;  // width/height are the image resolution
   // The lens of the raw images.
   RadTanDistortion<double> distortion;
+  std::optional<std::array<double, 4>> fisheye;  // Kannala-Brandt k1..k4, replacing `distortion`
   Eigen::Matrix4d bodyFromCamera = Eigen::Matrix4d::Identity();  // EuRoC T_BS
 
   EIGEN_MAKE_ALIGNED_OPERATOR_NEW
@@ -38,6 +44,7 @@ struct RectificationBlock {
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
   // The raw camera's distortion.
   RadTanDistortion<double> D;
+  std::optional<std::array<double, 4>> fisheye;  // Kannala-Brandt k1..k4 instead of D
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // rectified camera from raw camera
   Eigen::Matrix<double, 3, 4> P = Eigen::Matrix<double, 3, 4>::Zero();  // rectified projection
   // @{

@@ -5,7 +5,8 @@
 // as integer nanoseconds, so every dataset layout writes the same instants), and ground truth
 // pose(i) = T_wc of the left camera. The right camera of the rectified stereo pair sits at
 // +baseline along the left camera's x axis with the same orientation and intrinsics; depth is
-// metric along the left optical axis. Images are CV_8UC1: the rendered grey levels, averaged
+// metric along the left optical axis. With options.fisheye every image (left and right) is
+// rendered through fisheyeCamera() instead. Images are CV_8UC1: the rendered grey levels, averaged
 // over blurSubframes renders spread over `shutter` of the frame interval centred on the
 // frame's instant (motion blur), plus Gaussian noise of noiseSigma grey levels, rounded and
 // clamped; depth gets Gaussian noise of depthNoise on its inverse. Frames blackStart ..
@@ -14,10 +15,12 @@
 // changes nothing but its renderer's scratch buffers; use one sequence object per thread).
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include <opencv2/core.hpp>
 
+#include "orbis/camera/kannala_brandt.hpp"
 #include "orbis/camera/pinhole.hpp"
 #include "orbis/geometry/se3.hpp"
 #include "orbis/synth/loop_trajectory.hpp"
@@ -70,6 +73,11 @@ struct SynthOptions {
   // Seed of the scene, textures and noise; rays per pixel along each axis; rendering threads; the
   // room and the path.
   std::uint64_t seed = 1;
+  // Fisheye: render through a Kannala–Brandt lens (fisheyeCamera()) instead of the pinhole; fx is
+  // then derived so that the image's width spans fisheyeFovDegrees through the principal point.
+  bool fisheye = false;
+  double fisheyeFovDegrees = 180.0;
+  std::array<double, 4> fisheyeK{0.01, -0.002, 0.0005, 0.0};  // k1..k4, monotonic to well past 120°
   int supersample = 2;
   int threads = 1;
   RoomParams room;
@@ -105,7 +113,8 @@ class SyntheticSequence {
   // extra ones).
   const SynthOptions& options() const { return options_; }
   const Scene& scene() const { return scene_; }
-  PinholeCamera<double> camera() const;
+  PinholeCamera<double> camera() const;  // fisheye: the lens's tangent-plane pinhole
+  KannalaBrandtCamera<double> fisheyeCamera() const;  // meaningful when options().fisheye
   int size() const { return options_.frames; }  // one loop
   int totalFrames() const { return options_.frames + options_.extraFrames; }  // what writers write
   // @}

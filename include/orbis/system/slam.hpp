@@ -1,8 +1,9 @@
 // orbis/system/slam.hpp — the SLAM system a user instantiates: orbis::Slam<Sensor>.
 //
 // Contract: Slam<Sensor> turns each input into features with the sensor's compile-time
-// FeatureBuilder, then hands them to SlamCore<Sensor> (tracking, local mapping, loop closing over
-// one Map, every stage templated on the same sensor). track() returns the frame's pose and
+// FeatureBuilder, then hands them to SlamCore<PipelineSensor<Sensor>> (tracking, local mapping,
+// loop closing over one Map, every stage templated on the same sensor: Sensor itself, or the one
+// it names as its PipelineSensor, as MonocularFisheye names Monocular). track() returns the frame's pose and
 // tracking state. Two modes: threaded (real time: local mapping and loop closing run on their
 // own threads) and
 // deterministic (the same stages run inline in a fixed order after each frame, so the same
@@ -15,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "orbis/sensor/pipeline_sensor.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/system/slam_core.hpp"
 #include "orbis/util/timing.hpp"
@@ -36,11 +38,12 @@ class Slam {
   Slam(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
        SlamOptions options = {})
       : builder_(camera, orb), core_(camera, std::move(vocabulary), options) {}
-  // A monocular camera whose images still carry lens distortion (the builder undistorts keypoints).
-  Slam(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
-       std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options = {})
-    requires std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&,
-                                     const RadTanDistortion<double>&>
+  // A monocular camera whose images still carry lens distortion (the builder undistorts keypoints):
+  // RadTanDistortion for Monocular, the KannalaBrandtCamera for MonocularFisheye.
+  template <class Lens>
+  Slam(const Camera& camera, const OrbParams& orb, const Lens& lens, std::shared_ptr<const OrbVocabulary> vocabulary,
+       SlamOptions options = {})
+    requires std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&, const Lens&>
       : builder_(camera, orb, lens), core_(camera, std::move(vocabulary), options) {}
 
   // Extracts the input's features and tracks them; returns the state and, when tracked, the pose.
@@ -83,9 +86,10 @@ class Slam {
   // Per-stage timing.
   const StageTimer& timer() const { return core_.timer(); }
   // @{
-  // The core, for what Slam does not forward (map files, the map itself).
-  SlamCore<Sensor>& core() { return core_; }
-  const SlamCore<Sensor>& core() const { return core_; }
+  // The core, for what Slam does not forward (map files, the map itself): its pipeline sensor's.
+  using Core = SlamCore<PipelineSensor<Sensor>>;
+  Core& core() { return core_; }
+  const Core& core() const { return core_; }
   // @}
 
  private:
@@ -96,7 +100,7 @@ class Slam {
   }
 
   typename Sensor::FeatureBuilder builder_;
-  SlamCore<Sensor> core_;
+  SlamCore<PipelineSensor<Sensor>> core_;
 };
 
 }  // namespace orbis
