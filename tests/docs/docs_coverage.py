@@ -10,7 +10,8 @@ added. An option must appear in a page under docs/ that also names its command (
 Settings keys come from `orbis settings-keys --json` (the library's list of what the settings
 reader accepts) where the program has that command, and from the sources that read YAML with YamlReader (src/camera/yaml_reader.hpp):
 the literal keys of their reads (`yaml.real("Camera.fx")`, `positive(yaml, "Camera.fy")`, ...),
-and a prefix passed to a block reader combined with the keys read under it (`LEFT.` + `K`). Keys
+and, for a program without `settings-keys`, a prefix passed to a block reader combined with the
+keys read under it (`LEFT.` + `K`). Keys
 read by a settings reader (a source whose name has "settings") must be in the settings reference,
 docs/guide/settings.md; keys of other YAML files (EuRoC's sensor.yaml) anywhere under docs/.
 Exit 0 when everything is covered; 1 with one line per gap, naming it and where to document it.
@@ -70,7 +71,7 @@ def command_table(orbis):
     return table
 
 
-def settings_keys(source):
+def settings_keys(source, combine_prefixes=True):
     """(key, file) for every key a YamlReader user reads."""
     keys = []
     for path in sorted((source / 'src').rglob('*.cpp')):
@@ -82,7 +83,7 @@ def settings_keys(source):
         prefixes = {k for k in literals if k.endswith('.')}
         for key in sorted(literals - prefixes - suffixes):
             keys.append((key, path))
-        for prefix in sorted(prefixes):
+        for prefix in sorted(prefixes) if combine_prefixes else []:
             for suffix in sorted(suffixes):
                 keys.append((prefix + suffix, path))
     return sorted(set(keys))
@@ -114,9 +115,12 @@ def main():
                     'only in pages that do not name `' + name + '`'
                 gaps.append(f'option {option} of `{name}` is documented {where} '
                             f'(document it in the guide that covers `{name}`, e.g. docs/guide/commands.md)')
-    keys = settings_keys(source)
-    # The library's own list of the keys it reads (`orbis settings-keys`), where the program has it.
-    if any(words == ['settings-keys'] for words, _ in table):
+    # The library's own list of the keys it reads (`orbis settings-keys`), where the program has
+    # it; the sources' prefixed reads (prefix + "fx") then come from that list, not from guessing
+    # which prefix goes with which key.
+    listed_by_program = any(words == ['settings-keys'] for words, _ in table)
+    keys = settings_keys(source, combine_prefixes=not listed_by_program)
+    if listed_by_program:
         listed = subprocess.run([orbis, 'settings-keys', '--json'], capture_output=True, text=True, timeout=60)
         for entry in json.loads(listed.stdout):
             keys.append((entry['name'], source / 'src' / 'io' / 'settings.cpp'))

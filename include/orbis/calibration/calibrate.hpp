@@ -41,17 +41,31 @@
 
 namespace orbis::calibration {
 
+// The lens model a calibration fits: pinhole with radial-tangential distortion, or Kannala–Brandt
+// fisheye.
 enum class LensModel { Pinhole, Fisheye };  // pinhole: radial-tangential distortion
+// "pinhole" or "fisheye"; throws orbis::Error(source) otherwise.
 LensModel parseLensModel(const std::string& name, const std::string& source = "argument --model");
+// The model's name.
 const char* toString(LensModel model);
 
+// A calibrated camera: intrinsics and the lens model's distortion.
 struct CalibratedCamera {
+  // Pinhole or fisheye.
   LensModel model = LensModel::Pinhole;
+  // @{
+  // Image size, pixels.
   int width = 0, height = 0;
+  // @}
+  // @{
+  // Focal lengths and principal point, pixels.
   double fx = 0, fy = 0, cx = 0, cy = 0;
+  // @}
   std::vector<double> distortion;  // pinhole: k1 k2 p1 p2 k3; fisheye: k1 k2 k3 k4
 
+  // The pinhole part.
   PinholeCamera<double> pinhole() const { return {fx, fy, cx, cy, width, height}; }
+  // The radial-tangential distortion (pinhole model).
   RadTanDistortion<double> radTan() const;
   KannalaBrandtCamera<double> fisheye() const;  // maxAngle: fieldOfViewAngle()
   // The largest angle off axis any pixel of the image sees (radians; fisheye: within the
@@ -62,55 +76,86 @@ struct CalibratedCamera {
   Eigen::Vector3d bearing(const Eigen::Vector2d& px) const;
 };
 
+// One image of the pattern: its name, size and detected corners.
 struct CalibrationView {
+  // @{
+  // File name, image size, and the corners found (none: no pattern).
   std::string name;
   cv::Size imageSize;
   std::optional<PatternDetection> detection;
+  // @}
   double edgeWidth = 0;  // chessboard: mean black-to-white rise in pixels (smaller is sharper)
 };
 
+// Detects the pattern in a grey image.
 CalibrationView detectView(const cv::Mat& gray, const std::string& name, const CalibrationPattern& pattern);
 // Every image file (png, jpg, jpeg, bmp, tif, tiff, pgm, ppm) of `folder`, sorted by name.
 // onImage(done, total) reports progress. Throws orbis::Error for a missing or image-less folder.
 std::vector<CalibrationView> detectInFolder(const std::filesystem::path& folder, const CalibrationPattern& pattern,
                                             const std::function<void(std::size_t, std::size_t)>& onImage = {});
 
+// What calibrate() accepts and how it selects views.
 struct CalibrationOptions {
+  // Pinhole or fisheye.
   LensModel model = LensModel::Pinhole;
+  // @{
+  // Fewest views to calibrate from, and most views used (a well-spread subset).
   int minViews = 6;
   int maxViews = 40;
+  // @}
   double maxEdgeWidth = 4.0;        // pixels
   double duplicateFraction = 0.01;  // of the image diagonal
+  // Views whose error exceeds this × the median are outliers.
   double outlierFactor = 3.0;
   // Refused as degenerate when σ(fx)/fx or σ(fy)/fy exceeds this, or σ(cx), σ(cy) exceed
   // maxPrincipalPointSigma of the image width.
   double maxRelativeFocalSigma = 0.02;
+  // Largest σ(cx), σ(cy) as a share of the image width.
   double maxPrincipalPointSigma = 0.05;
 };
 
+// What became of one input view.
 struct ViewOutcome {
+  // @{
+  // Its name, and whether it was used.
   std::string name;
   bool used = false;
+  // @}
   std::string rejected;  // why not used: "no pattern", "blurred", "duplicate of X", "not selected", "outlier"
+  // Corners detected.
   int corners = 0;
   double rms = 0;        // pixels, for fitted views
+  // @{
+  // Whether it was an outlier, and its edge width (px).
   bool outlier = false;
   double edgeWidth = 0;
+  // @}
 };
 
+// The result of a calibration.
 struct CalibrationResult {
+  // The calibrated camera.
   CalibratedCamera camera;
   std::vector<std::string> parameterNames;  // fx fy cx cy then the distortion's
+  // @{
+  // The parameters and their standard deviations.
   std::vector<double> parameters, standardDeviations;
+  // @}
   double rms = 0;  // pixels, over every corner of the used views
+  // Views used.
   int viewsUsed = 0;
   std::vector<ViewOutcome> views;  // one per input view, in input order
   std::vector<SE3d> cameraFromBoard;  // per used view, in the order views lists them
+  // Names of the used views.
   std::vector<std::string> usedNames;
   std::vector<std::vector<cv::Point2f>> usedCorners;  // per used view: for the coverage picture
+  // What the user should know (few views, poor coverage, ...).
   std::vector<std::string> warnings;
 };
 
+// Calibrates from detected views (OpenCV's calibration for the chosen model), selecting views and
+// rejecting blurred, duplicate and outlier ones; throws orbis::Error naming source when too few
+// views or a degenerate set.
 CalibrationResult calibrate(const std::vector<CalibrationView>& views, const CalibrationPattern& pattern,
                             const CalibrationOptions& options, const std::string& source);
 

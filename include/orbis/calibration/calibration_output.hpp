@@ -22,15 +22,19 @@
 
 namespace orbis::calibration {
 
+// Writes an ORB-SLAM2-style settings file for the camera (Camera.type KannalaBrandt8 for a fisheye)
+// that orbis run takes unchanged.
 void writeCalibrationSettings(const std::filesystem::path& file, const CalibratedCamera& camera, double fps = 30.0);
 
 // The pinhole an image of `camera` is undistorted to (the same focal length for a pinhole; for a
 // fisheye, OpenCV's estimate that keeps only valid pixels), and the undistorted image.
 cv::Mat undistortToPinhole(const CalibratedCamera& camera, const cv::Mat& image, PinholeCamera<double>* pinhole = nullptr);
 
+// Writes the report: per-view errors, the coverage picture and the undistorted preview.
 void writeCalibrationReport(const std::filesystem::path& folder, const CalibrationResult& result,
                             const CalibrationPattern& pattern, const cv::Mat& preview);
 
+// The one-object JSON orbis calibrate --json prints.
 std::string calibrationJson(const CalibrationResult& result, const CalibrationPattern& pattern,
                             const std::filesystem::path& settings);
 

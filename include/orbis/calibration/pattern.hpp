@@ -24,35 +24,48 @@
 
 namespace orbis::calibration {
 
+// A chessboard or a ChArUco board.
 enum class PatternKind { Chessboard, Charuco };
 
+// A calibration target: its kind, size and square size.
 struct CalibrationPattern {
+  // Chessboard or ChArUco.
   PatternKind kind = PatternKind::Chessboard;
+  // @{
+  // Columns and rows.
   int cols = 9, rows = 6;      // chessboard: inner corners; ChArUco: squares
+  // @}
   double square = 0.025;       // metres
   double marker = 0.0;         // ChArUco marker side, metres
+  // ChArUco's marker dictionary (OpenCV aruco name).
   std::string dictionary = "DICT_4X4_50";
 
   // Corners the board has: chessboard cols x rows; ChArUco (cols-1) x (rows-1).
   int cornerCount() const;
+  // Corners along a row.
   int cornersAcross() const { return kind == PatternKind::Chessboard ? cols : cols - 1; }
+  // The board point (metres, z = 0) of corner id.
   Eigen::Vector3d objectPoint(int id) const;
   // The board's outer size in metres (squares, without the quiet zone).
   Eigen::Vector2d boardSize() const;
   std::string describe() const;  // the --pattern text that gives this pattern back
 };
 
+// Parses chessboard:COLSxROWS:SQUARE or charuco:COLSxROWS:SQUARE:MARKER[:DICT]; throws
+// orbis::Error(source).
 CalibrationPattern parsePattern(std::string_view text, const std::string& source = "argument --pattern");
 
 // The printed board: 8-bit grey, `pixelsPerSquare` per square, a white margin of one square all
 // round; board point (x, y) in metres is at pixel ((x / square + 1) * pixelsPerSquare - 0.5, ...).
 cv::Mat drawTarget(const CalibrationPattern& pattern, int pixelsPerSquare);
 
+// Corners found in an image, with their ids.
 struct PatternDetection {
   std::vector<cv::Point2f> corners;  // pixels
   std::vector<int> ids;              // corner ids (objectPoint), one per corner
 };
 
+// Finds the pattern in a grey image (sub-pixel corners), or nothing.
 std::optional<PatternDetection> detectPattern(const cv::Mat& gray, const CalibrationPattern& pattern);
 
 }  // namespace orbis::calibration

@@ -28,32 +28,51 @@
 
 namespace orbis {
 
+// The Kannala–Brandt equidistant fisheye (ORB-SLAM3's KannalaBrandt8): θd = θ(1 + k1θ² + k2θ⁴ +
+// k3θ⁶ + k4θ⁸), valid beyond 90° off axis.
 template <class S = double>
 struct KannalaBrandtCamera {
+  // @{
+  // The scalar, vector, observation and Jacobian types.
   using Scalar = S;
   using Vector2 = Eigen::Matrix<S, 2, 1>;
   using Vector3 = Eigen::Matrix<S, 3, 1>;
   using Observation = Vector2;
   using ProjectionJacobian = Eigen::Matrix<S, 2, 3>;
   using UnprojectionJacobian = Eigen::Matrix<S, 3, 2>;
+  // @}
 
+  // @{
+  // A 2-D observation, without metric depth.
   static constexpr int kObservationDim = 2;
   static constexpr bool kMetricDepth = false;
+  // @}
 
+  // @{
+  // Focal lengths and principal point, pixels.
   S fx{}, fy{}, cx{}, cy{};
+  // @}
+  // @{
+  // Distortion coefficients.
   S k1{}, k2{}, k3{}, k4{};
+  // @}
+  // @{
+  // Image size, pixels.
   int width = 0, height = 0;
+  // @}
   // Largest angle off axis (radians) the lens sees and the polynomial is trusted at; π: any.
   S maxAngle = S(std::numbers::pi);
 
   // Rays closer than this (radians) to the backward axis have no defined pixel.
   static constexpr S kBackwardMargin = S(1e-3);
 
+  // Whether a ray has a defined pixel (not within kBackwardMargin of the backward axis).
   static bool inFront(const Vector3& pc) {
     const S r = std::hypot(pc.x(), pc.y());
     return pc.norm() > S(1e-9) && std::atan2(r, pc.z()) < S(std::numbers::pi) - kBackwardMargin;
   }
 
+  // Whether a point lies within maxAngle of the optical axis.
   bool inFieldOfView(const Vector3& pc) const {
     return inFront(pc) && std::atan2(std::hypot(pc.x(), pc.y()), pc.z()) <= maxAngle;
   }
@@ -63,6 +82,7 @@ struct KannalaBrandtCamera {
     const S t2 = theta * theta;
     return theta * (S(1) + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))));
   }
+  // dθd/dθ.
   S distortAngleDerivative(S theta) const {
     const S t2 = theta * theta;
     return S(1) + t2 * (S(3) * k1 + t2 * (S(5) * k2 + t2 * (S(7) * k3 + t2 * S(9) * k4)));
@@ -85,6 +105,7 @@ struct KannalaBrandtCamera {
     return theta;
   }
 
+  // The pixel a camera-frame point projects to.
   Observation project(const Vector3& pc) const {
     const S r = std::hypot(pc.x(), pc.y());
     // On (or within rounding of) the axis θd/r → 1/z, the pinhole's scale.
@@ -156,8 +177,10 @@ struct KannalaBrandtCamera {
   // The point at distance `range` from the centre along the pixel's ray.
   Vector3 unprojectRange(const Vector2& px, S range) const { return bearing(px) * range; }
 
+  // Whether (u, v) lies inside the image.
   bool inImage(S u, S v) const { return u >= S(0) && v >= S(0) && u < S(width) && v < S(height); }
 
+  // A monocular camera: every point counts as far.
   S closeDepthThreshold() const { return std::numeric_limits<S>::infinity(); }
 
   // The field of view across the image's width/height/diagonal through the principal point,
@@ -166,6 +189,7 @@ struct KannalaBrandtCamera {
     return (undistortAngle(cx / fx) + undistortAngle((S(width) - cx) / fx)) * S(180) / S(std::numbers::pi);
   }
 
+  // The same camera in another scalar type.
   template <class T>
   KannalaBrandtCamera<T> cast() const {
     KannalaBrandtCamera<T> c;

@@ -20,6 +20,8 @@ namespace detail {
 void finishFisheye(FrameFeatures& f, const KannalaBrandtCamera<double>& lens, double maxAngle, int width, int height);
 }  // namespace detail
 
+// Features of a fisheye image: keypoints on the raw image, bearings through the lens, keypoints
+// within maxAngle of the axis.
 template <FeatureExtractor E>
 FrameFeatures extractFisheye(E& extractor, const cv::Mat& image, const KannalaBrandtCamera<double>& lens,
                              double maxAngle) {

@@ -24,21 +24,31 @@
 
 namespace orbis {
 
+// One fisheye camera: the pipeline runs as Monocular on the lens's tangent-plane pinhole, features
+// come through the Kannala–Brandt lens.
 struct MonocularFisheye {
   using Camera = PinholeCamera<double>;  // the lens's tangent plane
+  // @{
+  // The pipeline's sensor, the lens, the input and ORB-SLAM2's Huber kernel.
   using PipelineSensor = Monocular;
   using Lens = KannalaBrandtCamera<double>;
   using Input = MonocularInput;
   using RobustKernel = optim::HuberKernel;
+  // @}
+  // @{
+  // As Monocular.
   static constexpr SensorKind kKind = SensorKind::Monocular;
   static constexpr bool kMetricScale = false;
   static constexpr bool kDepthFromSensor = false;
   static constexpr int kInitialisationBudgetFactor = Monocular::kInitialisationBudgetFactor;
+  // @}
+  // Keypoints farther off axis than this (degrees) are dropped.
   static constexpr double kDefaultMaxKeypointAngleDegrees = 70.0;
 
   // The tangent-plane pinhole a lens gives the pipeline.
   static Camera planeOf(const Lens& lens) { return lens.centralPinhole(); }
 
+  // ORB on the raw fisheye image, keypoints through the lens.
   class FeatureBuilder {
    public:
     // `camera` is planeOf(lens), the pipeline's camera; the builder works from the lens.
@@ -48,11 +58,15 @@ struct MonocularFisheye {
           maxAngle_(std::min(maxKeypointAngleDegrees, 89.0) * std::numbers::pi / 180.0),
           trackingExtractor_(orb),
           initialisationExtractor_(initialisationParams(orb)) {}
+    // The frame's features.
     FrameFeatures build(const Input& in) {
       return extractFisheye(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, lens_, maxAngle_);
     }
+    // @{
+    // Whether the builder uses the initialisation budget.
     void setInitialising(bool initialising) { isInitialising_ = initialising; }
     bool initialising() const { return isInitialising_; }
+    // @}
 
    private:
     static OrbParams initialisationParams(OrbParams orb) {

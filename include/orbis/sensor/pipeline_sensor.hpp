@@ -11,19 +11,25 @@
 
 namespace orbis {
 
+// The sensor configuration the pipeline is instantiated for: the sensor itself, or its
+// PipelineSensor.
 template <class S>
 struct PipelineSensorOf {
+  // The sensor.
   using type = S;
 };
 
+// A sensor that runs on another's pipeline (MonocularFisheye on Monocular's).
 template <class S>
   requires requires { typename S::PipelineSensor; }
 struct PipelineSensorOf<S> {
+  // That sensor.
   using type = typename S::PipelineSensor;
   static_assert(std::same_as<typename S::Camera, typename type::Camera> &&
                 std::same_as<typename S::Input, typename type::Input>);
 };
 
+// The pipeline's sensor of S.
 template <class S>
 using PipelineSensor = typename PipelineSensorOf<S>::type;
 

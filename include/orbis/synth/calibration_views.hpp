@@ -26,23 +26,33 @@
 
 namespace orbis::synth {
 
+// What renderCalibrationViews renders: a printed pattern seen by a camera from random poses.
 struct CalibrationViewsOptions {
+  // @{
+  // The pattern and the camera (pinhole or fisheye).
   calibration::CalibrationPattern pattern;
   calibration::CalibratedCamera camera;
+  // @}
+  // @{
+  // Views, seed, rays per pixel along each axis, and image noise (grey levels).
   int views = 30;
   std::uint64_t seed = 1;
   int supersample = 3;
   double noiseSigma = 0.0;
+  // @}
   int pixelsPerSquare = 64;  // of the printed board, before its pyramid
   // Camera-from-board poses to render instead of random ones (then `views` is ignored).
   std::vector<SE3d> poses;
 };
 
+// One rendered view.
 struct RenderedCalibrationView {
   cv::Mat image;  // CV_8UC1
+  // The board's pose in the camera.
   SE3d cameraFromBoard;
 };
 
+// Renders views of the pattern with exact poses (the calibration tests' ground truth).
 std::vector<RenderedCalibrationView> renderCalibrationViews(const CalibrationViewsOptions& options);
 
 // Returns the images' folder.

@@ -46,6 +46,7 @@ class Renderer {
   // cameraToWorld.
   void render(const Scene& scene, const PinholeCamera<double>& camera, const SE3d& cameraToWorld,
               cv::Mat& gray, cv::Mat* depth = nullptr);
+  // The same through a fisheye lens.
   void render(const Scene& scene, const KannalaBrandtCamera<double>& camera, const SE3d& cameraToWorld,
               cv::Mat& gray, cv::Mat* depth = nullptr);
 
