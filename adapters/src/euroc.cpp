@@ -65,6 +65,9 @@ class EurocReader final : public DatasetReader {
 
   DatasetCamera camera() const override {
     if (!options_.rectify) {
+      if (leftSensor_.fisheye)
+        throw Error(root_.string(), "", "an unrectified fisheye has no pinhole camera: give its Kannala-Brandt "
+                                        "settings (Camera.type: KannalaBrandt8) or open it with rectify = true");
       if (sensor_ == SensorKind::Monocular) return leftSensor_.intrinsics;
       throw Error(root_.string(), "",
                   "unrectified EuRoC stereo has no RectifiedStereoCamera; "
@@ -91,14 +94,27 @@ class EurocReader final : public DatasetReader {
   }
 
  private:
-  // Stereo: OpenCV's rectification (camera module); monocular: plain undistortion with the
-  // same intrinsics.
+  // Stereo: OpenCV's rectification (camera module, fisheye pairs included); monocular: plain
+  // undistortion with the same intrinsics (a fisheye: to the pinhole OpenCV estimates for it).
   void prepareRectification() {
     if (sensor_ == SensorKind::Monocular) {
       const PinholeCamera<double>& k = leftSensor_.intrinsics;
       const RadTanDistortion<double>& d = leftSensor_.distortion;
       cv::Mat cameraMatrix, coefficients = (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);
       cv::eigen2cv(k.K(), cameraMatrix);
+      if (const auto& fisheye = leftSensor_.fisheye) {
+        // A fisheye is undistorted to the pinhole OpenCV picks for it (balance 0: valid pixels only).
+        const cv::Mat kb = (cv::Mat_<double>(1, 4) << (*fisheye)[0], (*fisheye)[1], (*fisheye)[2], (*fisheye)[3]);
+        const cv::Size size(k.width, k.height);
+        cv::Mat newK;
+        cv::fisheye::estimateNewCameraMatrixForUndistortRectify(cameraMatrix, kb, size, cv::Mat::eye(3, 3, CV_64F), newK,
+                                                                0.0, size, 1.0);
+        cv::fisheye::initUndistortRectifyMap(cameraMatrix, kb, cv::Mat::eye(3, 3, CV_64F), newK, size, CV_32FC1,
+                                             leftMapX_, leftMapY_);
+        rectifiedPinhole_ = {newK.at<double>(0, 0), newK.at<double>(1, 1), newK.at<double>(0, 2),
+                             newK.at<double>(1, 2), k.width, k.height};
+        return;
+      }
       cv::initUndistortRectifyMap(cameraMatrix, coefficients, cv::Mat(), cameraMatrix,
                                   cv::Size(k.width, k.height), CV_32FC1, leftMapX_, leftMapY_);
       rectifiedPinhole_ = k;

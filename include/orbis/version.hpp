@@ -2,5 +2,6 @@
 #pragma once
 
 namespace orbis {
+// The library's version, "MAJOR.MINOR.PATCH".
 const char* versionString();
 }

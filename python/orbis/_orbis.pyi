@@ -241,3 +241,9 @@ class BalProblem:
 def read_bal(path: PathLike) -> BalProblem: ...
 def solve_bal(problem: BalProblem, huber: float = 1.0, max_iterations: int = 50, function_tolerance: float = 1e-6,
               linear_solver: str = "auto") -> Dict[str, Any]: ...
+
+# ---- calibration ------------------------------------------------------------------------------
+
+def calibrate(folder: PathLike, pattern: str, model: str = "pinhole", out: Optional[PathLike] = None,
+              report: Optional[PathLike] = None, min_views: int = 6, max_views: int = 40, max_blur: float = 4.0,
+              fps: float = 30.0) -> Dict[str, Any]: ...

@@ -28,6 +28,7 @@ void bindDatasets(py::module_& m);    // Dataset, Frame, open_dataset (datasets.
 void bindTrajectories(py::module_& m);  // read_trajectory, write_trajectory (trajectories.cpp)
 void bindEvaluation(py::module_& m);  // ate, rpe, kitti_metric (evaluation.cpp)
 void bindBundleAdjustment(py::module_& m);  // BalProblem, solve_bal (bundle_adjustment.cpp)
+void bindCalibration(py::module_& m);  // calibrate (calibration.cpp)
 
 // Shared by the bindings: a sensor name ('mono', 'stereo', 'rgbd'; ValueError otherwise), and a
 // camera as a dict of its model and parameters (settings.cpp).

@@ -17,4 +17,5 @@ PYBIND11_MODULE(_orbis, m) {
   bindSlam(m);
   bindEvaluation(m);
   bindBundleAdjustment(m);
+  bindCalibration(m);
 }

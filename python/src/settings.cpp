@@ -32,9 +32,16 @@ py::dict describeCamera(const CameraVariant& camera) {
         using C = std::decay_t<decltype(c)>;
         py::dict d;
         const PinholeCamera<double>* pinhole = nullptr;
+        [[maybe_unused]] PinholeCamera<double> central;
         if constexpr (std::is_same_v<C, PinholeCamera<double>>) {
           d["model"] = "pinhole";
           pinhole = &c;
+        } else if constexpr (std::is_same_v<C, KannalaBrandtCamera<double>>) {
+          d["model"] = "kannala_brandt";
+          d["k1"] = c.k1, d["k2"] = c.k2, d["k3"] = c.k3, d["k4"] = c.k4;
+          d["max_angle_deg"] = c.maxAngle * 180.0 / M_PI;
+          central = c.centralPinhole();
+          pinhole = &central;
         } else {
           d["model"] = std::is_same_v<C, RgbdCamera<double>> ? "rgbd" : "stereo";
           pinhole = &c.pinhole;

@@ -36,7 +36,7 @@ py::dict statsDict(const SlamStats& s, const RelocalisationStats& r, std::size_t
   return py::dict("frames"_a = s.frames, "tracked"_a = s.tracked, "lost"_a = s.lost, "keyframes"_a = s.keyFrames,
                   "map_points"_a = s.mapPoints, "loop_closures"_a = s.loopClosures,
                   "relocalisation_attempts"_a = r.attempts, "relocalisations"_a = r.successes,
-                  "keyframes_loaded"_a = loadedKeyFrames);
+                  "keyframes_loaded"_a = loadedKeyFrames, "maps"_a = s.maps, "map_merges"_a = s.mapMerges);
 }
 
 py::list timingList(const std::vector<StageStats>& stages) {
@@ -81,6 +81,46 @@ void bindQueries(py::class_<SlamSession<Sensor>>& c) {
       .def("track_times", [](Session& s) { return vectorToArray(s.trackTimes()); },
            "Wall time in ms of each track() call's C++ part (ORB extraction and tracking, plus mapping\n"
            "inline in deterministic mode); a call's time seen from Python minus this is the binding's.")
+      .def(
+          "maps",
+          [](Session& s) {
+            py::list out;
+            for (const AtlasMapInfo& m : s.locked([](S& slam) { return slam.core().maps(); }))
+              out.append(py::dict("id"_a = m.id, "keyframes"_a = m.keyFrames, "map_points"_a = m.mapPoints,
+                                  "start_frame"_a = m.startFrame, "active"_a = m.active,
+                                  "merged_into"_a = m.merged ? py::object(py::int_(m.mergedInto)) : py::none()));
+            return out;
+          },
+          "The atlas: every map opened, as dicts id, keyframes, map_points, start_frame, active,\n"
+          "merged_into (None, or the map it was merged into).")
+      .def_property_readonly(
+          "active_map", [](Session& s) { return s.locked([](S& slam) { return slam.core().activeMapId(); }); },
+          "Id of the map tracking works in.")
+      .def(
+          "merges",
+          [](Session& s) {
+            py::list out;
+            for (const MapMergeEvent& e : s.locked([](S& slam) { return slam.core().merges(); }))
+              out.append(py::dict("frame"_a = e.frameIndex, "other_frame"_a = e.otherFrameIndex, "current_keyframe"_a = e.current,
+                                  "other_keyframe"_a = e.other, "active_map"_a = e.activeMap,
+                                  "other_map"_a = e.otherMap, "moved_map"_a = e.movedMap, "kept_map"_a = e.keptMap,
+                                  "inliers"_a = e.inliers, "fused_points"_a = e.fusedPoints, "scale"_a = e.scale,
+                                  "rotation_wxyz"_a = py::make_tuple(e.rotation[0], e.rotation[1], e.rotation[2],
+                                                                     e.rotation[3]),
+                                  "translation"_a = py::make_tuple(e.translation[0], e.translation[1], e.translation[2]),
+                                  "ms"_a = e.milliseconds));
+            return out;
+          },
+          "Merges of two maps so far, in order: frame, keyframes, maps, inliers, the move (x_kept =\n"
+          "scale * R * x_moved + translation) and the time it took.")
+      .def(
+          "trajectory_maps",
+          [](Session& s, bool current) {
+            const auto maps = s.locked([current](S& slam) { return slam.core().trajectoryMaps(current); });
+            return vectorToArray(std::vector<double>(maps.begin(), maps.end()));
+          },
+          "current"_a = false,
+          "Per row of trajectory(): the map the frame was tracked in (current=True: the map holding it now).")
       .def_property_readonly("state", [](Session& s) { return s.locked([](S& slam) { return slam.state(); }); })
       .def_property_readonly("camera", [](const Session& s) { return describeCamera(s.camera()); });
   c.def(
@@ -212,16 +252,21 @@ std::unique_ptr<SlamSession<Sensor>> makeSession(const DatasetReader& dataset, s
 template <class Sensor, class Source>
 void bindConstructor(py::class_<SlamSession<Sensor>>& c, const char* source, const char* doc) {
   c.def(py::init([](const Source& from, std::shared_ptr<OrbVocabulary> vocabulary, bool deterministic,
-                    bool localisationOnly, bool loopClosing, std::uint32_t seed, std::optional<double> fps) {
+                    bool localisationOnly, bool loopClosing, std::uint32_t seed, std::optional<double> fps, bool atlas,
+                    int newMapAfterLostFrames, double newMapAfterLostSeconds) {
           SlamOptions o;
           o.deterministic = deterministic;
           o.localisationOnly = localisationOnly;
           o.loopClosing = loopClosing;
           o.seed = seed;
+          o.atlas = atlas;
+          o.newMapAfterLostFrames = newMapAfterLostFrames;
+          o.newMapAfterLostSeconds = newMapAfterLostSeconds;
           return makeSession<Sensor>(from, std::move(vocabulary), o, fps);
         }),
         py::arg(source), "vocabulary"_a = py::none(), py::kw_only(), "deterministic"_a = false,
-        "localisation_only"_a = false, "loop_closing"_a = true, "seed"_a = 0, "fps"_a = py::none(), doc);
+        "localisation_only"_a = false, "loop_closing"_a = true, "seed"_a = 0, "fps"_a = py::none(), "atlas"_a = true,
+        "new_map_after_lost_frames"_a = 10, "new_map_after_lost_seconds"_a = 0.3, doc);
 }
 
 template <class Sensor>
@@ -230,7 +275,10 @@ void bindSlamClass(py::module_& m, const char* name, const char* doc) {
   bindConstructor<Sensor, Settings>(c, "settings",
                                     "From Settings: camera, ORB parameters and fps from the file. deterministic runs\n"
                                     "mapping and loop closing inline (same input, same trajectory); seed seeds RANSAC\n"
-                                    "(0 by default, as `orbis run`); fps overrides the file's.");
+                                    "(0 by default, as `orbis run`); fps overrides the file's. atlas=False keeps\n"
+                                    "ORB-SLAM2's single map (lost until relocalised); otherwise a new map starts once\n"
+                                    "relocalisation failed new_map_after_lost_frames frames over\n"
+                                    "new_map_after_lost_seconds, and maps merge when a common place is seen.");
   bindConstructor<Sensor, DatasetReader>(c, "dataset",
                                          "From a Dataset's own calibration, with `orbis run`'s ORB budget and fps for\n"
                                          "its kind (TUM 1000 / 30, EuRoC 1200 / 20, KITTI 2000 / 10).");

@@ -16,11 +16,14 @@ CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml) 
   if (const auto model = yaml.optionalString("camera_model"); model && *model != "pinhole") {
     throw yaml.error("camera_model", "only pinhole is supported, found \"" + *model + "\"");
   }
-  if (const auto model = yaml.optionalString("distortion_model"); model && *model != "radial-tangential") {
-    throw yaml.error("distortion_model", "only radial-tangential is supported, found \"" + *model + "\"");
+  const auto model = yaml.optionalString("distortion_model");
+  const bool equidistant = model && (*model == "equidistant" || *model == "fisheye" || *model == "kannala-brandt");
+  if (model && !equidistant && *model != "radial-tangential" && *model != "radtan") {
+    throw yaml.error("distortion_model", "expected radial-tangential or equidistant (Kannala-Brandt), found \"" +
+                                             *model + "\"");
   }
   const std::vector<double> k = yaml.reals("intrinsics", 4, 4);
-  const std::vector<double> d = yaml.reals("distortion_coefficients", 4, 5);
+  const std::vector<double> d = yaml.reals("distortion_coefficients", 4, equidistant ? 4 : 5);
   const std::vector<double> resolution = yaml.reals("resolution", 2, 2);
   if (!(k[0] > 0 && k[1] > 0)) throw yaml.error("intrinsics", "focal lengths fu, fv must be positive");
   if (!(resolution[0] >= 1 && resolution[1] >= 1 && resolution[0] <= 1e5 && resolution[1] <= 1e5 &&
@@ -29,7 +32,8 @@ CameraCalibration readEurocCalibration(const std::filesystem::path& sensorYaml) 
 
   CameraCalibration c;
   c.intrinsics = {k[0], k[1], k[2], k[3], static_cast<int>(resolution[0]), static_cast<int>(resolution[1])};
-  c.distortion = {d[0], d[1], d[2], d[3], d.size() == 5 ? d[4] : 0.0};
+  if (equidistant) c.fisheye = std::array<double, 4>{d[0], d[1], d[2], d[3]};
+  else c.distortion = {d[0], d[1], d[2], d[3], d.size() == 5 ? d[4] : 0.0};
   c.bodyFromCamera = yaml.matrix("T_BS", 4, 4);
   const Eigen::Matrix3d R = c.bodyFromCamera.topLeftCorner<3, 3>();
   if (!(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0 ||

@@ -8,6 +8,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "orbis/camera/kannala_brandt.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis {
@@ -24,7 +25,22 @@ cv::Mat coefficients(const RadTanDistortion<double>& d) {
   return (cv::Mat_<double>(1, 5) << d.k1, d.k2, d.p1, d.p2, d.k3);
 }
 
+cv::Mat fisheyeCoefficients(const std::array<double, 4>& k) { return (cv::Mat_<double>(1, 4) << k[0], k[1], k[2], k[3]); }
+
+KannalaBrandtCamera<double> fisheyeOf(const Eigen::Matrix3d& K, const std::array<double, 4>& k) {
+  KannalaBrandtCamera<double> lens;
+  lens.fx = K(0, 0), lens.fy = K(1, 1), lens.cx = K(0, 2), lens.cy = K(1, 2);
+  lens.k1 = k[0], lens.k2 = k[1], lens.k3 = k[2], lens.k4 = k[3];
+  return lens;
+}
+
 void buildMaps(const RectificationBlock& block, cv::Mat& mapX, cv::Mat& mapY) {
+  if (block.fisheye) {
+    cv::fisheye::initUndistortRectifyMap(toCv(block.K), fisheyeCoefficients(*block.fisheye), toCv(block.R),
+                                         toCv(block.P.leftCols<3>()), cv::Size(block.width, block.height), CV_32FC1,
+                                         mapX, mapY);
+    return;
+  }
   cv::initUndistortRectifyMap(toCv(block.K), coefficients(block.D), toCv(block.R),
                               toCv(block.P.leftCols<3>()), cv::Size(block.width, block.height), CV_32FC1, mapX,
                               mapY);
@@ -33,8 +49,9 @@ void buildMaps(const RectificationBlock& block, cv::Mat& mapX, cv::Mat& mapY) {
 Eigen::Vector2d rectifyPixel(const RectificationBlock& block, const Eigen::Vector2d& raw) {
   const PinholeCamera<double> intrinsics{block.K(0, 0), block.K(1, 1), block.K(0, 2), block.K(1, 2),
                                          block.width, block.height};
-  const Eigen::Vector2d xn = block.D.undistort(intrinsics.pixelToNormalized(raw));
-  const Eigen::Vector3d ray = block.P.leftCols<3>() * (block.R * xn.homogeneous());
+  const Eigen::Vector3d rawRay = block.fisheye ? fisheyeOf(block.K, *block.fisheye).bearing(raw)
+                                               : block.D.undistort(intrinsics.pixelToNormalized(raw)).homogeneous();
+  const Eigen::Vector3d ray = block.P.leftCols<3>() * (block.R * rawRay);
   return ray.hnormalized();
 }
 
@@ -100,14 +117,24 @@ StereoRectification rectifyStereo(const CameraCalibration& left, const CameraCal
 
   const cv::Size size(kl.width, kl.height);
   cv::Mat R1, R2, P1, P2, Q;
-  cv::stereoRectify(toCv(kl.K()), coefficients(left.distortion), toCv(kr.K()), coefficients(right.distortion), size,
-                    toCv(rotation), toCv(translation), R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+  if (left.fisheye.has_value() != right.fisheye.has_value())
+    throw Error(source, "", "one camera of the pair is a fisheye and the other is not: calibrate both with one model");
+  if (left.fisheye) {
+    cv::fisheye::stereoRectify(toCv(kl.K()), fisheyeCoefficients(*left.fisheye), toCv(kr.K()),
+                               fisheyeCoefficients(*right.fisheye), size, toCv(rotation), toCv(translation), R1, R2, P1,
+                               P2, Q, cv::CALIB_ZERO_DISPARITY, size, 0.0, 1.0);
+  } else {
+    cv::stereoRectify(toCv(kl.K()), coefficients(left.distortion), toCv(kr.K()), coefficients(right.distortion), size,
+                      toCv(rotation), toCv(translation), R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+  }
 
   RectificationBlock l, r;
   l.K = kl.K();
   r.K = kr.K();
   l.D = left.distortion;
   r.D = right.distortion;
+  l.fisheye = left.fisheye;
+  r.fisheye = right.fisheye;
   cv::cv2eigen(R1, l.R);
   cv::cv2eigen(R2, r.R);
   cv::cv2eigen(P1, l.P);

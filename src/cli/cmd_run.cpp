@@ -76,6 +76,8 @@ int runCommand(const std::vector<std::string>& rawArgs) {
       .option("--load-map", "FILE", "start from a saved map (same sensor, camera and vocabulary) and relocalise in it")
       .option("--save-map", "FILE", "save the final map (keyframes, points, graphs) for a later --load-map")
       .flag("--no-loop", "disable loop closing")
+      .flag("--single-map", "ORB-SLAM2's single map: stay lost until relocalised instead of starting a new map of the atlas")
+      .option("--new-map-after", "FRAMES:SECONDS", "start a new map once relocalisation failed on FRAMES frames spanning SECONDS", "10:0.3")
       .flag("--json", "print the report as JSON on standard output")
       .flag("--stats", "write DIR/stats.jsonl: per-frame tracking and per-keyframe mapping counters (diagnosis)")
       .option("--viewer", "[PORT]", "serve a live view of the run at http://127.0.0.1:PORT/ (default port 8080)")
@@ -96,6 +98,19 @@ int runCommand(const std::vector<std::string>& rawArgs) {
   options.stats = p.has("--stats");
   options.localisationOnly = p.has("--localize");
   options.loopClosing = !p.has("--no-loop");
+  options.atlas = !p.has("--single-map");
+  {
+    const std::string after = p.get("--new-map-after");
+    const auto colon = after.find(':');
+    try {
+      options.newMapAfterLostFrames = std::stoi(after.substr(0, colon));
+      if (colon != std::string::npos) options.newMapAfterLostSeconds = std::stod(after.substr(colon + 1));
+    } catch (const std::exception&) {
+      throw Error("argument --new-map-after", "", "expected FRAMES:SECONDS, e.g. 10:0.3, not '" + after + "'");
+    }
+    if (options.newMapAfterLostFrames < 1 || options.newMapAfterLostSeconds < 0)
+      throw Error("argument --new-map-after", "", "expected at least 1 frame and 0 or more seconds");
+  }
   if (auto d = p.getOptional("--dense")) options.denseCloud = *d;
   if (auto m = p.getOptional("--load-map")) options.loadMap = *m;
   if (auto m = p.getOptional("--save-map")) options.saveMap = *m;
@@ -148,6 +163,11 @@ void printReport(const RunReport& r, const RunOptions& options, bool json) {
     else std::printf("initialised    never");
     std::printf("%s%s%s\n", waits.empty() ? "" : " (frames waiting: ", waits.c_str(), waits.empty() ? "" : ")");
   }
+  if (r.maps.size() > 1) {
+    std::size_t live = 0;
+    for (const AtlasMapInfo& m : r.maps) live += m.merged ? 0 : 1;
+    std::printf("atlas          %zu maps opened, %zu merges, %zu maps left\n", r.maps.size(), r.merges.size(), live);
+  }
   if (options.loadMap || r.relocalisationAttempts)
     std::printf("relocalised    %zu of %zu attempts; %zu keyframes loaded%s\n", r.relocalisations,
                 r.relocalisationAttempts, r.keyFramesLoaded,
@@ -163,7 +183,7 @@ void printReport(const RunReport& r, const RunOptions& options, bool json) {
   for (const StageStats& s : r.timing)
     std::printf("%-32s %7zu %9.2f %9.2f %9.2f\n", s.stage.c_str(), s.count, s.meanMs, s.medianMs, s.p95Ms);
   for (const auto& w : readableWarnings(foldWarnings(r.warnings))) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  std::printf("\noutputs in %s (trajectory.txt, keyframes.txt, report.json, map.ply, overview.png)\n",
+  std::printf("\noutputs in %s (trajectory.txt, trajectory_maps.txt, keyframes.txt, report.json, map.ply, overview.png)\n",
               options.outDir.string().c_str());
 }
 

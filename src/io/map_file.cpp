@@ -23,6 +23,8 @@ namespace {
 constexpr char kMagic[8] = {'O', 'R', 'B', 'I', 'S', 'M', 'A', 'P'};
 constexpr std::size_t kHeaderBytesVersion1 = 8 + 4 + 4 + 8 + 8 + 10 * 8 + 8 + 8;
 constexpr std::uint32_t kFirstVersionWithScale = 2;
+constexpr std::uint32_t kFirstVersionWithAtlas = 3;
+constexpr std::uint8_t kRootFlag = 1, kGaugeFlag = 2;
 constexpr std::size_t kTrailerBytes = 8;
 constexpr std::size_t kDeclaredSizeOffset = 16;  // after magic, version and sensor
 
@@ -262,6 +264,17 @@ void writeMapFile(const fs::path& file, const Map& map, const MapFileInfo& info)
     w.put<std::int32_t>(p->found());
     w.putArray(observations);
   }
+  // The atlas (version 3): the maps' records, the active map, each keyframe's map and flags.
+  w.put<std::uint64_t>(map.mapRecords().size());
+  for (const AtlasMapRecord& m : map.mapRecords()) {
+    w.put<std::uint64_t>(m.startFrame);
+    w.put<std::int64_t>(m.mergedInto ? static_cast<std::int64_t>(*m.mergedInto) : -1);
+  }
+  w.put<std::uint32_t>(map.activeMapId());
+  for (const KeyFrame* kf : keyFrames) {
+    w.put<std::uint32_t>(kf->mapId());
+    w.put<std::uint8_t>(static_cast<std::uint8_t>((kf->isMapRoot() ? kRootFlag : 0) | (kf->isGauge() ? kGaugeFlag : 0)));
+  }
   w.put<std::uint64_t>(0);  // the trailer, filled in by sealMapFileBytes
   sealMapFileBytes(w.bytes());
   writeFileAtomically(file, w.bytes());
@@ -307,6 +320,7 @@ MapFileInfo checkedHeader(const std::vector<char>& bytes, const std::string& fil
   } else {
     info.metricScale = info.sensor != SensorKind::Monocular;  // version 1: monocular was the only such sensor
   }
+  info.version = version;
   headerEnd = header.position();
   return info;
 }
@@ -442,6 +456,30 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
     }
     points.push_back(std::move(p));
   }
+  // The atlas (version 3); an older file holds one map.
+  std::vector<AtlasMapRecord> maps{AtlasMapRecord{}};
+  std::uint32_t activeMap = 0;
+  std::vector<std::pair<std::uint32_t, std::uint8_t>> keyFrameMaps(keyFrames.size(), {0, 0});
+  if (info.version >= kFirstVersionWithAtlas) {
+    maps.resize(r.count(16, "atlas maps"));
+    if (maps.empty()) r.fail("atlas without maps");
+    for (std::size_t m = 0; m < maps.size(); ++m) {
+      maps[m].id = static_cast<std::uint32_t>(m);
+      maps[m].startFrame = r.get<std::uint64_t>("atlas map");
+      const auto into = r.get<std::int64_t>("atlas map");
+      if (into >= static_cast<std::int64_t>(maps.size()) || into == static_cast<std::int64_t>(m) || into < -1)
+        r.fail("atlas map merged into an unknown map or itself");
+      if (into >= 0) maps[m].mergedInto = static_cast<std::uint32_t>(into);
+    }
+    activeMap = r.get<std::uint32_t>("active map");
+    if (activeMap >= maps.size() || maps[activeMap].mergedInto) r.fail("active map unknown or merged");
+    for (auto& [mapId, flags] : keyFrameMaps) {
+      mapId = r.get<std::uint32_t>("keyframe map");
+      flags = r.get<std::uint8_t>("keyframe map flags");
+      if (mapId >= maps.size() || maps[mapId].mergedInto) r.fail("keyframe in an unknown or merged map");
+      if (flags > (kRootFlag | kGaugeFlag) || (flags == kGaugeFlag)) r.fail("impossible keyframe map flags");
+    }
+  }
   if (r.position() != bytes.size() - kTrailerBytes) r.fail("unexpected bytes after the last map point");
 
   std::vector<KeyFrame*> created;
@@ -468,6 +506,14 @@ MapFileInfo readMapFile(const fs::path& path, Map& map, const MapFileInfo& expec
     for (const Edge& e : keyFrames[k].edges) kf->addConnection(keyFrameOf(e.keyFrame), static_cast<int>(e.weight));
     if (keyFrames[k].parent >= 0) kf->changeParent(keyFrameOf(static_cast<std::uint64_t>(keyFrames[k].parent)));
     for (std::uint64_t l : keyFrames[k].loops) kf->addLoopEdge(keyFrameOf(l));
+  }
+  if (info.version >= kFirstVersionWithAtlas) {
+    for (std::size_t k = 0; k < keyFrames.size(); ++k) {
+      created[k]->setMapId(keyFrameMaps[k].first);
+      created[k]->setMapRoot((keyFrameMaps[k].second & kRootFlag) != 0);
+      created[k]->setGauge((keyFrameMaps[k].second & kGaugeFlag) != 0);
+    }
+    map.restoreAtlas(std::move(maps), activeMap);
   }
   return info;
 }

@@ -2,6 +2,7 @@
 #include "orbis/io/settings.hpp"
 
 #include <array>
+#include <cmath>
 #include <iterator>
 
 #include "../camera/yaml_reader.hpp"
@@ -28,6 +29,17 @@ constexpr SettingsKey kSettingsKeys[] = {
     {"Camera.fps", "number", "frame rate (optional, 0 or absent: 30)"},
     {"Camera.bf", "number", "stereo baseline times fx (stereo and rgbd)"},
     {"Camera.RGB", "whole number", "1: colour images are RGB, 0: BGR"},
+    {"Camera.type", "text", "lens model: PinHole (default) or KannalaBrandt8 (fisheye, ORB-SLAM3)"},
+    {"Camera.k4", "number", "KannalaBrandt8: fisheye coefficient k4 (k1..k3 as Camera.k1..k3)"},
+    {"Camera.maxAngle", "number", "KannalaBrandt8: widest angle off axis the lens is trusted at, degrees (orbis, default 180)"},
+    {"Camera1.fx", "number", "ORB-SLAM3 layout (KannalaBrandt8): focal length in x, pixels"},
+    {"Camera1.fy", "number", "ORB-SLAM3 layout: focal length in y, pixels"},
+    {"Camera1.cx", "number", "ORB-SLAM3 layout: principal point x, pixels"},
+    {"Camera1.cy", "number", "ORB-SLAM3 layout: principal point y, pixels"},
+    {"Camera1.k1", "number", "ORB-SLAM3 layout: fisheye coefficient k1"},
+    {"Camera1.k2", "number", "ORB-SLAM3 layout: fisheye coefficient k2"},
+    {"Camera1.k3", "number", "ORB-SLAM3 layout: fisheye coefficient k3"},
+    {"Camera1.k4", "number", "ORB-SLAM3 layout: fisheye coefficient k4"},
     {"System.seed", "whole number", "seed of every random choice of the system (orbis, default 0)"},
     {"ThDepth", "number", "close/far depth threshold, in baselines (default 40)"},
     {"DepthMapFactor", "number", "raw depth / factor = metres (rgbd)"},
@@ -95,6 +107,42 @@ PinholeCamera<double> readPinhole(const YamlReader& yaml) {
   return camera;
 }
 
+// Camera.type: KannalaBrandt8, with ORB-SLAM3's keys under Camera1. (File.version 1.0) or Camera.
+KannalaBrandtCamera<double> readKannalaBrandt(const YamlReader& yaml) {
+  const std::string prefix = yaml.has("Camera1.fx") ? "Camera1." : "Camera.";
+  KannalaBrandtCamera<double> camera;
+  camera.fx = positive(yaml, prefix + "fx");
+  camera.fy = positive(yaml, prefix + "fy");
+  camera.cx = yaml.real(prefix + "cx");
+  camera.cy = yaml.real(prefix + "cy");
+  camera.k1 = yaml.real(prefix + "k1");
+  camera.k2 = yaml.real(prefix + "k2");
+  camera.k3 = yaml.real(prefix + "k3");
+  camera.k4 = yaml.real(prefix + "k4");
+  if (yaml.has("Camera.width")) camera.width = positiveInteger(yaml, "Camera.width");
+  if (yaml.has("Camera.height")) camera.height = positiveInteger(yaml, "Camera.height");
+  if (const auto maxAngle = yaml.optionalReal("Camera.maxAngle")) {
+    if (!(*maxAngle > 0 && *maxAngle <= 180)) throw yaml.error("Camera.maxAngle", "expected degrees in (0, 180]");
+    camera.maxAngle = *maxAngle * M_PI / 180.0;
+  }
+  // The polynomial must increase over the angles it is used at, or pixels have two rays.
+  for (double theta = 0.01; theta <= camera.maxAngle; theta += 0.01) {
+    if (camera.distortAngleDerivative(theta) <= 0) {
+      throw yaml.error(prefix + "k1",
+                       "the fisheye polynomial k1..k4 stops increasing at " + std::to_string(theta * 180 / M_PI) +
+                           " degrees off axis: set Camera.maxAngle below that, or check the coefficients");
+    }
+  }
+  return camera;
+}
+
+bool isFisheye(const YamlReader& yaml) {
+  const auto type = yaml.optionalString("Camera.type");
+  if (!type || *type == "PinHole" || *type == "Pinhole" || *type == "pinhole") return false;
+  if (*type == "KannalaBrandt8" || *type == "KannalaBrandt" || *type == "fisheye") return true;
+  throw yaml.error("Camera.type", "expected PinHole or KannalaBrandt8, found \"" + *type + "\"");
+}
+
 RadTanDistortion<double> readDistortion(const YamlReader& yaml) {
   return {yaml.real("Camera.k1"), yaml.real("Camera.k2"), yaml.real("Camera.p1"), yaml.real("Camera.p2"),
           yaml.optionalReal("Camera.k3").value_or(0.0)};
@@ -137,8 +185,11 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
   Settings s;
   s.source = file;
   s.sensor = chooseSensor(yaml, requested);
-  const PinholeCamera<double> pinhole = readPinhole(yaml);
-  s.distortion = readDistortion(yaml);
+  const bool fisheye = isFisheye(yaml);
+  std::optional<KannalaBrandtCamera<double>> lens;
+  if (fisheye) lens = readKannalaBrandt(yaml);
+  const PinholeCamera<double> pinhole = fisheye ? lens->centralPinhole() : readPinhole(yaml);
+  if (!fisheye) s.distortion = readDistortion(yaml);
   s.orb = readOrbParams(yaml);
 
   if (const auto fps = yaml.optionalReal("Camera.fps")) {
@@ -162,10 +213,17 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
 
   switch (s.sensor) {
     case SensorKind::Monocular:
-      s.camera = pinhole;
+      if (lens) s.camera = *lens;
+      else s.camera = pinhole;
       break;
     case SensorKind::Stereo:
     case SensorKind::Rgbd: {
+      if (fisheye) {
+        throw yaml.error("Camera.type", "a KannalaBrandt8 camera runs monocular here; a fisheye stereo pair is "
+                                        "rectified to a pinhole pair on load from the dataset's calibration "
+                                        "(EuRoC/TUM-VI sensor.yaml with distortion_model: equidistant), whose "
+                                        "rectified camera is then used: drop --settings or give pinhole settings");
+      }
       const double baseline = positive(yaml, "Camera.bf") / pinhole.fx;
       const double closeDepth = s.thDepth * baseline;
       if (s.sensor == SensorKind::Stereo) {

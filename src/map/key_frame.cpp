@@ -115,7 +115,7 @@ void KeyFrame::updateConnections() {
   }
   connectedWeights_ = std::move(kept);
   updateBestCovisibles();
-  if (firstConnection_ && id != 0) {
+  if (firstConnection_ && !mapRoot_) {  // a map's root stays the root of its spanning tree
     parent_ = orderedConnected_.front();
     parent_->addChild(this);
     firstConnection_ = false;
@@ -133,7 +133,7 @@ void KeyFrame::changeParent(KeyFrame* parent) {
 }
 
 bool KeyFrame::setBad() {
-  if (id == 0 || protected_ || bad_) return false;
+  if (mapRoot_ || protected_ || bad_) return false;
   for (const auto& [kf, w] : connectedWeights_) kf->eraseConnection(this);
   for (std::size_t i = 0; i < points_.size(); ++i)
     if (MapPoint* p = points_[i]) {

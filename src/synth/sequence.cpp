@@ -49,10 +49,24 @@ SyntheticSequence::SyntheticSequence(const SynthOptions& options)
   require(options.flatCount >= 0, "flat", "count must not be negative");
   require(options.flatCount == 0 || options.flatStart >= 0, "flat", "start must not be negative");
   require(options.supersample >= 1, "supersample", "must be at least 1");
+  require(!options.fisheye || (options.fisheyeFovDegrees >= 10.0 && options.fisheyeFovDegrees <= 240.0), "fov",
+          "must lie in [10, 240] degrees");
   scene_ = makeRoomScene(options.room, options.seed);
 }
 
+KannalaBrandtCamera<double> SyntheticSequence::fisheyeCamera() const {
+  KannalaBrandtCamera<double> c;
+  c.k1 = options_.fisheyeK[0], c.k2 = options_.fisheyeK[1], c.k3 = options_.fisheyeK[2], c.k4 = options_.fisheyeK[3];
+  c.fx = c.fy = 0.5 * options_.width / c.distortAngle(0.5 * options_.fisheyeFovDegrees * M_PI / 180.0);
+  c.cx = 0.5 * options_.width;
+  c.cy = 0.5 * options_.height;
+  c.width = options_.width;
+  c.height = options_.height;
+  return c;
+}
+
 PinholeCamera<double> SyntheticSequence::camera() const {
+  if (options_.fisheye) return fisheyeCamera().centralPinhole();
   PinholeCamera<double> c;
   c.fx = c.fy = options_.fx;
   c.cx = 0.5 * options_.width;
@@ -90,7 +104,8 @@ cv::Mat SyntheticSequence::renderImage(int i, const SE3d& leftToCamera, int came
     const SE3d subPose = poseAtPhase((i + offset) / options_.frames) * leftToCamera;
     // Depth belongs to the frame's instant: the central sub-frame when there is one.
     const bool centre = n % 2 == 1 && k == n / 2;
-    renderer_.render(scene_, cam, subPose, gray, centre ? depth : nullptr);
+    if (options_.fisheye) renderer_.render(scene_, fisheyeCamera(), subPose, gray, centre ? depth : nullptr);
+    else renderer_.render(scene_, cam, subPose, gray, centre ? depth : nullptr);
     if (k == 0) sum = gray.clone();
     else sum += gray;
   }
@@ -98,7 +113,8 @@ cv::Mat SyntheticSequence::renderImage(int i, const SE3d& leftToCamera, int came
   if (isFlat(i)) sum.setTo(128.0);  // textureless: only the noise is left
   if (depth && n % 2 == 0) {
     // Even sub-frame counts have no sample at the frame's instant: render its depth separately.
-    renderer_.render(scene_, cam, pose(i) * leftToCamera, gray, depth);
+    if (options_.fisheye) renderer_.render(scene_, fisheyeCamera(), pose(i) * leftToCamera, gray, depth);
+    else renderer_.render(scene_, cam, pose(i) * leftToCamera, gray, depth);
   }
   cv::Mat out(cam.height, cam.width, CV_8UC1);
   SynthRng rng(mixSeed(options_.seed, static_cast<std::uint64_t>(i) + 1, static_cast<std::uint64_t>(cameraIndex) + 1));

@@ -94,7 +94,8 @@ void writeEurocSensorYaml(const fs::path& file, const SyntheticSequence& seq, in
   const PinholeCamera<double> cam = seq.camera();
   const double shift = cameraIndex == 0 ? 0.0 : seq.options().baseline;
   TextFile f(file);
-  f.puts("%YAML:1.0\n# Synthetic camera written by orbis synth: already rectified.\n");
+  f.puts(seq.options().fisheye ? "%YAML:1.0\n# Synthetic fisheye camera written by orbis synth: rectified on load.\n"
+                                : "%YAML:1.0\n# Synthetic camera written by orbis synth: already rectified.\n");
   f.puts("sensor_type: camera\n");
   f.printf("comment: orbis synthetic cam%d\n\n", cameraIndex);
   f.puts("# Sensor extrinsics wrt. the body-frame (body = cam0).\nT_BS:\n  cols: 4\n  rows: 4\n");
@@ -103,7 +104,14 @@ void writeEurocSensorYaml(const fs::path& file, const SyntheticSequence& seq, in
   f.printf("rate_hz: %g\nresolution: [%d, %d]\ncamera_model: pinhole\n", seq.options().fps, cam.width, cam.height);
   f.puts("intrinsics: [" + yamlReal(cam.fx) + ", " + yamlReal(cam.fy) + ", " + yamlReal(cam.cx) + ", " +
          yamlReal(cam.cy) + "] #fu, fv, cu, cv\n");
-  f.puts("distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n");
+  if (seq.options().fisheye) {
+    // Kalibr's (and TUM-VI's) name for the Kannala-Brandt model.
+    const KannalaBrandtCamera<double> lens = seq.fisheyeCamera();
+    f.puts("distortion_model: equidistant\ndistortion_coefficients: [" + yamlReal(lens.k1) + ", " + yamlReal(lens.k2) +
+           ", " + yamlReal(lens.k3) + ", " + yamlReal(lens.k4) + "]\n");
+  } else {
+    f.puts("distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n");
+  }
   f.close();
 }
 
@@ -143,11 +151,18 @@ void writeSynthSettings(const fs::path& file, const SyntheticSequence& seq, std:
   f.printf("System.seed: %llu\n\n", static_cast<unsigned long long>(o.seed & 0x7fffffffULL));
   f.puts("Camera.fx: " + yamlReal(c.fx) + "\nCamera.fy: " + yamlReal(c.fy) + "\nCamera.cx: " + yamlReal(c.cx) +
          "\nCamera.cy: " + yamlReal(c.cy) + "\n\n");
-  f.puts("Camera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n\n");
+  if (o.fisheye) {
+    const KannalaBrandtCamera<double> lens = seq.fisheyeCamera();
+    f.puts("# Kannala-Brandt (equidistant fisheye) lens, ORB-SLAM3's keys.\nCamera.type: \"KannalaBrandt8\"\n");
+    f.puts("Camera.k1: " + yamlReal(lens.k1) + "\nCamera.k2: " + yamlReal(lens.k2) + "\nCamera.k3: " +
+           yamlReal(lens.k3) + "\nCamera.k4: " + yamlReal(lens.k4) + "\n\n");
+  } else {
+    f.puts("Camera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\nCamera.k3: 0.0\n\n");
+  }
   f.printf("Camera.width: %d\nCamera.height: %d\n\n", c.width, c.height);
   f.puts("Camera.fps: " + yamlReal(o.fps) + "\n\n");
   f.puts("# Stereo baseline times fx (virtual for RGB-D).\n");
-  f.puts("Camera.bf: " + yamlReal(c.fx * o.baseline) + "\n\n");
+  if (!o.fisheye) f.puts("Camera.bf: " + yamlReal(c.fx * o.baseline) + "\n\n");
   f.puts("# Colour order of the images (0: BGR, 1: RGB); they are grey.\nCamera.RGB: 1\n\n");
   f.puts("# Close/far threshold, in baselines.\nThDepth: 40.0\n\n");
   if (sensor == "rgbd") f.puts("# Raw depth value / DepthMapFactor = metres.\nDepthMapFactor: 5000.0\n\n");
@@ -272,7 +287,8 @@ SynthWriteResult writeSynthSequence(SyntheticSequence& seq, SynthLayout layout, 
   }
   result.settings = outDir / "settings.yaml";
   result.settingsMono = outDir / "settings_mono.yaml";
-  writeSynthSettings(result.settings, seq, layout == SynthLayout::Tum ? "rgbd" : "stereo");
+  // A fisheye runs monocular from settings; its stereo pair is rectified on load from sensor.yaml.
+  writeSynthSettings(result.settings, seq, seq.options().fisheye ? "mono" : layout == SynthLayout::Tum ? "rgbd" : "stereo");
   writeSynthSettings(result.settingsMono, seq, "mono");
   result.renderSeconds = renderSeconds;
   result.renderCpuSeconds = renderCpuSeconds;

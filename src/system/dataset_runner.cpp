@@ -11,6 +11,7 @@
 #include "orbis/io/overview.hpp"
 #include "orbis/io/ply.hpp"
 #include "orbis/io/settings.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
 #include "orbis/util/progress.hpp"
@@ -65,6 +66,36 @@ void writeEvents(const fs::path& file, const std::vector<StageEvent>& events) {
   }
 }
 
+// The atlas (docs/guide/atlas.md): maps with their frames, merges with their transform.
+void writeAtlas(JsonWriter& w, const RunReport& r) {
+  std::map<std::uint32_t, std::size_t> framesPerMap;
+  for (std::uint32_t m : r.frameMaps) ++framesPerMap[m];
+  w.key("maps").beginArray();
+  for (const AtlasMapInfo& m : r.maps) {
+    w.beginObject().field("id", std::size_t{m.id}).field("start_frame", m.startFrame).field("frames_tracked", framesPerMap[m.id]);
+    w.field("keyframes", m.keyFrames).field("map_points", m.mapPoints).field("active", m.active);
+    w.key("merged_into");
+    if (m.merged) w.value(std::size_t{m.mergedInto});
+    else w.null();
+    w.endObject();
+  }
+  w.endArray();
+  w.key("merges").beginArray();
+  for (const MapMergeEvent& e : r.merges) {
+    w.beginObject().field("frame", e.frameIndex).field("other_frame", e.otherFrameIndex);
+    w.field("current_keyframe", e.current).field("other_keyframe", e.other);
+    w.field("active_map", std::size_t{e.activeMap}).field("other_map", std::size_t{e.otherMap}).field("moved_map", std::size_t{e.movedMap});
+    w.field("kept_map", std::size_t{e.keptMap}).field("moved_keyframes", e.movedKeyFrames).field("moved_points", e.movedPoints);
+    w.field("inliers", e.inliers).field("fused_points", e.fusedPoints).field("scale", e.scale);
+    w.key("rotation_wxyz").beginArray();
+    for (int k = 0; k < 4; ++k) w.value(e.rotation[k]);
+    w.endArray().key("translation").beginArray();
+    for (int k = 0; k < 3; ++k) w.value(e.translation[k]);
+    w.endArray().field("ms", e.milliseconds).endObject();
+  }
+  w.endArray();
+}
+
 void writeReport(const fs::path& file, const RunReport& r) {
   JsonWriter w;
   w.beginObject();
@@ -107,6 +138,7 @@ void writeReport(const fs::path& file, const RunReport& r) {
     w.field("inliers", e.inliers).field("scale", e.scale).endObject();
   }
   w.endArray();
+  writeAtlas(w, r);
   // Repeated warnings folded (a few of each kind, then a count), as the program prints them.
   const std::vector<WarningKind> kinds = foldWarnings(r.warnings);
   w.key("warnings").beginArray();
@@ -135,6 +167,10 @@ template <>
 MonocularInput makeInput<Monocular>(const DatasetFrame& f) {
   return {f.timestamp, f.left};
 }
+template <>
+MonocularInput makeInput<MonocularFisheye>(const DatasetFrame& f) {
+  return {f.timestamp, f.left};
+}
 
 bool inputComplete(const StereoInput& in) { return !in.left.empty() && !in.right.empty(); }
 bool inputComplete(const RgbdInput& in) { return !in.image.empty() && !in.depth.empty(); }
@@ -142,8 +178,8 @@ bool inputComplete(const MonocularInput& in) { return !in.image.empty(); }
 
 // A monocular camera's images may still carry lens distortion; the stereo and RGB-D inputs the
 // runner feeds are rectified or undistorted.
-template <class Sensor>
-Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
+template <class Sensor, class Lens>
+Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& orb, const Lens& lens,
                       std::shared_ptr<const OrbVocabulary> vocabulary, const SlamOptions& options) {
   if constexpr (Sensor::kKind == SensorKind::Monocular) return Slam<Sensor>(camera, orb, lens, std::move(vocabulary), options);
   else return Slam<Sensor>(camera, orb, std::move(vocabulary), options);
@@ -175,8 +211,8 @@ class FramePacer {
   std::chrono::steady_clock::time_point firstFed_;
 };
 
-template <class Sensor>
-void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<double>& lens, const OrbParams& orb,
+template <class Sensor, class Lens>
+void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbParams& orb,
              double fps, DatasetReader& dataset, const RunOptions& options, RunReport& report) {
   auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
   SlamOptions slamOptions;
@@ -185,6 +221,9 @@ void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<doubl
   slamOptions.loopClosing = options.loopClosing;
   slamOptions.fps = fps;
   slamOptions.liveCamera = options.realtime;
+  slamOptions.atlas = options.atlas;
+  slamOptions.newMapAfterLostFrames = options.newMapAfterLostFrames;
+  slamOptions.newMapAfterLostSeconds = options.newMapAfterLostSeconds;
   Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, vocabulary, slamOptions);
   slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {
@@ -263,12 +302,25 @@ void runWith(const typename Sensor::Camera& camera, const RadTanDistortion<doubl
   report.stats = slam.stats();
   report.timing = slam.timer().summary();
   if (const auto* closer = slam.core().loopCloser()) report.loopClosures = closer->closures();
+  report.maps = slam.core().maps();
+  report.merges = slam.core().merges();
+  report.frameMaps = slam.core().trajectoryMaps();
+  const std::vector<std::uint32_t> frameMapsNow = slam.core().trajectoryMaps(true);
 
   fs::create_directories(options.outDir);
   const Trajectory trajectory = slam.trajectory();
   const Trajectory keyFrames = slam.keyFrameTrajectory();
   writeTrajectory(options.outDir / "trajectory.txt", trajectory, TrajectoryFormat::Tum);
   writeTrajectory(options.outDir / "keyframes.txt", keyFrames, TrajectoryFormat::Tum);
+  {
+    std::ofstream maps(options.outDir / "trajectory_maps.txt");
+    maps << "# timestamp map_tracked_in map_now\n";
+    char line[96];
+    for (std::size_t i = 0; i < trajectory.size() && i < report.frameMaps.size(); ++i) {
+      std::snprintf(line, sizeof line, "%.6f %u %u\n", trajectory[i].t, report.frameMaps[i], frameMapsNow[i]);
+      maps << line;
+    }
+  }
   auto cloud = slam.mapPointCloud();
   writePly(options.outDir / "map.ply", cloud);
 
@@ -345,7 +397,18 @@ RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
     const Settings s = Settings::load(*options.settings, dataset.sensor());
     orb = s.orb;
     fps = s.fps;
-    camera = std::visit([](const auto& c) -> DatasetCamera { return c; }, s.camera);
+    if (const auto* fisheye = std::get_if<KannalaBrandtCamera<double>>(&s.camera)) {
+      // Settings pick the instantiation once: a monocular Kannala-Brandt lens (settings.hpp).
+      report.sensor = std::string(toString(dataset.sensor())) + " (fisheye)";
+      runWith<MonocularFisheye>(MonocularFisheye::planeOf(*fisheye), *fisheye, orb, fps, dataset, options, report);
+      return report;
+    }
+    camera = std::visit(
+        [](const auto& c) -> DatasetCamera {
+          if constexpr (std::is_same_v<std::decay_t<decltype(c)>, KannalaBrandtCamera<double>>) return c.centralPinhole();
+          else return c;
+        },
+        s.camera);
     lens = s.distortion;
   } else {
     camera = dataset.camera();

@@ -14,6 +14,7 @@ MapSnapshot snapshotOfMap(const Map& map) {
     k.frameIndex = kf->frameIndex;
     k.Twc = kf->Twc();
     if (kf->parent()) k.parent = static_cast<std::int64_t>(kf->parent()->id);
+    k.mapId = kf->mapId();
     for (const KeyFrame* c : kf->covisiblesWithWeightAtLeast(MapSnapshot::kStrongCovisibility))
       if (c->id > kf->id) k.covisibles.push_back(c->id);  // each edge once
     for (const KeyFrame* l : kf->loopEdges()) k.loopEdges.push_back(l->id);

@@ -12,7 +12,9 @@ bool moved(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
 }
 
 bool keyFrameChanged(const KeyFrameSnapshot& sent, const KeyFrameSnapshot& now) {
-  if (sent.parent != now.parent || sent.covisibles != now.covisibles || sent.loopEdges != now.loopEdges) return true;
+  if (sent.parent != now.parent || sent.covisibles != now.covisibles || sent.loopEdges != now.loopEdges ||
+      sent.mapId != now.mapId)
+    return true;
   // Translation in metres, rotation entries (about radians for small turns): one tolerance.
   return (sent.Twc.matrix3x4() - now.Twc.matrix3x4()).cwiseAbs().maxCoeff() > MapDeltaEncoder::kMoveTolerance;
 }
@@ -20,7 +22,7 @@ bool keyFrameChanged(const KeyFrameSnapshot& sent, const KeyFrameSnapshot& now) 
 void writeKeyFrame(JsonOut& out, const KeyFrameSnapshot& k) {
   out.separator().raw("{");
   out.key("id").integer(static_cast<long long>(k.id)).key("frame").integer(static_cast<long long>(k.frameIndex));
-  out.key("parent").integer(k.parent).key("Twc").pose(k.Twc);
+  out.key("parent").integer(k.parent).key("map").integer(k.mapId).key("Twc").pose(k.Twc);
   out.key("covisibles").raw("[");
   for (KeyFrameId c : k.covisibles) out.separator().integer(static_cast<long long>(c));
   out.raw("]").key("loops").raw("[");
@@ -62,6 +64,15 @@ void writeLoopClosures(JsonOut& out, const std::vector<LoopClosureEvent>& closur
   out.raw("]");
 }
 
+void writeMerges(JsonOut& out, const std::vector<MapMergeEvent>& merges) {
+  out.key("merges").raw("[");
+  for (const MapMergeEvent& e : merges) {
+    out.separator().raw("{").key("frame").integer(static_cast<long long>(e.frameIndex));
+    out.key("kept").integer(e.keptMap).key("moved").integer(e.movedMap).key("inliers").integer(e.inliers).raw("}");
+  }
+  out.raw("]");
+}
+
 // Drops what the snapshot of message `seq` no longer held (points, keyframes: id -> entry with
 // seenIn); returns their ids.
 template <typename SentById>
@@ -86,6 +97,7 @@ MapDeltaEncoder::Message MapDeltaEncoder::encode(const MapSnapshot& map, const s
   live_ = live;
   frames_ = map.frames;
   loopClosures_ = map.loopClosures;
+  merges_ = map.merges;
   JsonOut out;
   writeHeader(out, seq, false, live, map.frames);
 
@@ -125,6 +137,7 @@ MapDeltaEncoder::Message MapDeltaEncoder::encode(const MapSnapshot& map, const s
   trajectory_.insert(trajectory_.end(), map.trajectory.begin() + static_cast<std::ptrdiff_t>(from), map.trajectory.end());
   writeTrajectory(out, trajectory_, from);
   writeLoopClosures(out, loopClosures_);
+  writeMerges(out, merges_);
   return {seq, out.raw("}").take()};
 }
 
@@ -142,6 +155,7 @@ MapDeltaEncoder::Message MapDeltaEncoder::full() const {
   writeIds(out, "removedPoints", {});
   writeTrajectory(out, trajectory_, 0);
   writeLoopClosures(out, loopClosures_);
+  writeMerges(out, merges_);
   return {seq_, out.raw("}").take()};
 }
 

@@ -11,10 +11,11 @@
 // and full() may be called from different threads.
 //
 // Message JSON: {"seq","full","live","frames",
-//   "keyFrames":[{"id","frame","parent","Twc":[12, row-major 3x4],"covisibles":[ids],"loops":[ids]}],
+//   "keyFrames":[{"id","frame","parent","map","Twc":[12, row-major 3x4],"covisibles":[ids],"loops":[ids]}],
 //   "removedKeyFrames":[ids],"points":[id,x,y,z,firstKeyFrame,inLocalMap,...],"removedPoints":[ids],
 //   "trajectoryFrom":i,"trajectory":[x,y,z,... of cameras i, i+1, ...],"trajectoryLength":n,
-//   "loopClosures":[{"current","loop","frame","inliers"}] (all of them)}
+//   "loopClosures":[{"current","loop","frame","inliers"}] (all of them),
+//   "merges":[{"frame","kept","moved","inliers"}] (maps of the atlas merged, all of them)}
 // keyFrames and points: new or changed ones (all of them in a full message); the page replaces
 // its trajectory from camera trajectoryFrom on. Camera coordinates as orbis keeps them (x right,
 // y down, z forward), metres, 4 decimals.
@@ -66,6 +67,7 @@ class MapDeltaEncoder {
   std::map<KeyFrameId, SentKeyFrame> keyFrames_;
   std::vector<Eigen::Vector3f> trajectory_;
   std::vector<LoopClosureEvent> loopClosures_;
+  std::vector<MapMergeEvent> merges_;
 };
 
 }  // namespace orbis::viewer_detail

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "orbis/camera/camera_model.hpp"
+#include "orbis/camera/kannala_brandt.hpp"
 
 namespace orbis {
 namespace {
@@ -42,6 +43,17 @@ template <> RectifiedStereoCamera<double> makeCamera() { return {testPinhole<dou
 template <> RectifiedStereoCamera<float> makeCamera() { return {testPinhole<float>(), 0.11f}; }
 template <> RgbdCamera<double> makeCamera() { return {testPinhole<double>(), 0.08, 5000.0}; }
 template <> RgbdCamera<float> makeCamera() { return {testPinhole<float>(), 0.08f, 5000.0f}; }
+// A 640x480 fisheye of about 190 degrees across (coefficients of ORB-SLAM3's TUM-VI file).
+template <class S>
+KannalaBrandtCamera<S> testFisheye() {
+  KannalaBrandtCamera<S> c;
+  c.fx = S(190.98), c.fy = S(190.97), c.cx = S(318.4), c.cy = S(241.7);
+  c.k1 = S(0.0034), c.k2 = S(0.0007), c.k3 = S(-0.0020), c.k4 = S(0.0003);
+  c.width = 640, c.height = 480;
+  return c;
+}
+template <> KannalaBrandtCamera<double> makeCamera() { return testFisheye<double>(); }
+template <> KannalaBrandtCamera<float> makeCamera() { return testFisheye<float>(); }
 
 template <class C> std::string modelName();
 template <> std::string modelName<PinholeCamera<double>>() { return "PinholeCamera<double>"; }
@@ -50,6 +62,8 @@ template <> std::string modelName<RectifiedStereoCamera<double>>() { return "Rec
 template <> std::string modelName<RectifiedStereoCamera<float>>() { return "RectifiedStereoCamera<float>"; }
 template <> std::string modelName<RgbdCamera<double>>() { return "RgbdCamera<double>"; }
 template <> std::string modelName<RgbdCamera<float>>() { return "RgbdCamera<float>"; }
+template <> std::string modelName<KannalaBrandtCamera<double>>() { return "KannalaBrandtCamera<double>"; }
+template <> std::string modelName<KannalaBrandtCamera<float>>() { return "KannalaBrandtCamera<float>"; }
 
 // Points in front of the camera, 0.3 m to 30 m deep, spread over and beyond the image.
 std::vector<Eigen::Vector3d> randomPoints(unsigned seed, int count) {
@@ -67,7 +81,8 @@ template <class C>
 class CameraModelTest : public ::testing::Test {};
 
 using CameraTypes = ::testing::Types<PinholeCamera<double>, RectifiedStereoCamera<double>, RgbdCamera<double>,
-                                     PinholeCamera<float>, RectifiedStereoCamera<float>, RgbdCamera<float>>;
+                                     PinholeCamera<float>, RectifiedStereoCamera<float>, RgbdCamera<float>,
+                                     KannalaBrandtCamera<double>, KannalaBrandtCamera<float>>;
 TYPED_TEST_SUITE(CameraModelTest, CameraTypes);
 
 TYPED_TEST(CameraModelTest, ProjectUnprojectRoundTrip) {

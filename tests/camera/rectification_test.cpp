@@ -14,7 +14,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <Eigen/Geometry>
+
 #include "orbis/camera/euroc_calibration.hpp"
+#include "orbis/camera/kannala_brandt.hpp"
 #include "orbis/io/settings.hpp"
 #include "orbis/util/error.hpp"
 #include "test_data.hpp"
@@ -114,7 +117,18 @@ TEST(EurocCalibration, MalformedFilesNameFileAndKey) {
   };
   expectError("missing.yaml", replace("intrinsics: [458.6, 457.3, 367.2, 248.4]\n", ""), "intrinsics");
   expectError("short.yaml", replace("[458.6, 457.3, 367.2, 248.4]", "[458.6, 457.3, 367.2]"), "intrinsics");
-  expectError("model.yaml", replace("radial-tangential", "equidistant"), "distortion_model");
+  expectError("model.yaml", replace("radial-tangential", "omnidirectional"), "distortion_model");
+  // Kalibr's equidistant model is the Kannala-Brandt fisheye: four coefficients, no more.
+  expectError("fisheye5.yaml", replace("distortion_model: radial-tangential\ndistortion_coefficients: [-0.28, 0.07, 0.0002, 0.00002]",
+                                       "distortion_model: equidistant\ndistortion_coefficients: [0.01, 0.0, 0.0, 0.0, 0.1]"),
+              "distortion_coefficients");
+  {
+    std::ofstream(dir / "fisheye.yaml") << replace("distortion_model: radial-tangential", "distortion_model: equidistant");
+    const CameraCalibration fisheye = readEurocCalibration(dir / "fisheye.yaml");
+    ASSERT_TRUE(fisheye.fisheye.has_value());
+    EXPECT_DOUBLE_EQ((*fisheye.fisheye)[0], -0.28);
+    EXPECT_TRUE(fisheye.distortion.isZero());
+  }
   expectError("pose.yaml", replace("data: [1, 0,", "data: [2, 0,"), "T_BS");
   std::filesystem::remove_all(dir);
 }
@@ -213,6 +227,43 @@ TEST(StereoRectification, RejectsInconsistentPairs) {
   CameraCalibration smaller = right;
   smaller.intrinsics.width = 640;
   EXPECT_THROW(rectifyStereo(left, smaller), Error);
+}
+
+}  // namespace
+}  // namespace orbis
+
+namespace orbis {
+namespace {
+
+// A fisheye pair (Kannala-Brandt, 20 cm apart, the right one turned by 2 degrees) rectified to a
+// pinhole pair: a scene point lands on one row in both rectified images, at disparity bf / Z.
+TEST(Rectification, FisheyePairRectifiedToPinholes) {
+  CameraCalibration left, right;
+  left.intrinsics = right.intrinsics = {190.0, 190.0, 320.0, 240.0, 640, 480};
+  left.fisheye = right.fisheye = std::array<double, 4>{0.01, -0.002, 0.0005, 0.0};
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  right.bodyFromCamera.topLeftCorner<3, 3>() = turn;
+  right.bodyFromCamera(0, 3) = 0.2;
+  const StereoRectification r = rectifyStereo(left, right);
+  EXPECT_NEAR(r.camera.baseline, 0.2, 1e-9);
+  ASSERT_FALSE(r.leftMapX.empty());
+  KannalaBrandtCamera<double> lens;
+  lens.fx = lens.fy = 190.0, lens.cx = 320.0, lens.cy = 240.0, lens.k1 = 0.01, lens.k2 = -0.002, lens.k3 = 0.0005;
+  int checked = 0;
+  for (double x : {-0.8, 0.0, 0.9})
+    for (double y : {-0.5, 0.3})
+      for (double z : {2.0, 5.0}) {
+        const Eigen::Vector3d inLeft(x, y, z);
+        const Eigen::Vector3d inRight = turn.transpose() * (inLeft - Eigen::Vector3d(0.2, 0, 0));
+        const Eigen::Vector2d l = r.rectifyLeftPixel(lens.project(inLeft));
+        const Eigen::Vector2d rr = r.rectifyRightPixel(lens.project(inRight));
+        EXPECT_NEAR(l.y(), rr.y(), 1e-6);
+        // Depth in the rectified left frame: the rectifying rotation turns the camera slightly.
+        const double depth = (r.left.R * inLeft).z();
+        EXPECT_NEAR(l.x() - rr.x(), r.camera.bf() / depth, 1e-6);
+        ++checked;
+      }
+  EXPECT_EQ(checked, 12);
 }
 
 }  // namespace

@@ -330,6 +330,19 @@ TEST(MapFile, RecordsWhetherTheScaleIsMetric) {
   fs::remove(file);
 }
 
+// The atlas section a version 3 file ends with (before the trailer): its length.
+std::size_t atlasSectionBytes(const Map& map) {
+  return 8 + 16 * map.mapRecords().size() + 4 + 5 * map.keyFrameCount();
+}
+
+// Turns a version 3 file's bytes into a version 2 file's: no atlas section.
+void downgradeToVersionTwo(std::vector<char>& bytes, const Map& map) {
+  ASSERT_EQ(bytes[kVersionOffset], 3);
+  bytes[kVersionOffset] = 2;
+  const auto trailer = bytes.end() - 8;
+  bytes.erase(trailer - static_cast<std::ptrdiff_t>(atlasSectionBytes(map)), trailer);
+}
+
 // A version 1 file (before the scale flag) still loads: its scale follows from its sensor.
 TEST(MapFile, VersionOneFilesLoadWithTheScaleOfTheirSensor) {
   for (const bool monocular : {false, true}) {
@@ -339,7 +352,7 @@ TEST(MapFile, VersionOneFilesLoadWithTheScaleOfTheirSensor) {
     const MapFileInfo expected = monocular ? monocularExpectation() : expectation();
     writeMapFile(file, map, expected);
     std::vector<char> bytes = readBytes(file);
-    ASSERT_EQ(bytes[kVersionOffset], 2);
+    downgradeToVersionTwo(bytes, map);
     bytes[kVersionOffset] = 1;
     bytes.erase(bytes.begin() + kScaleFlagOffset, bytes.begin() + kScaleFlagOffset + 4);
     resealMapFile(bytes);
@@ -347,14 +360,74 @@ TEST(MapFile, VersionOneFilesLoadWithTheScaleOfTheirSensor) {
     Map loaded;
     const MapFileInfo info = readMapFile(file, loaded, expected);
     EXPECT_EQ(info.metricScale, !monocular);
+    EXPECT_EQ(info.version, 1u);
     EXPECT_EQ(loaded.keyFrameCount(), map.keyFrameCount());
     EXPECT_EQ(loaded.mapPointCount(), map.mapPointCount());
-    bytes[kVersionOffset] = 3;  // a newer format than this reader knows
+    bytes[kVersionOffset] = 4;  // a newer format than this reader knows
     resealMapFile(bytes);
     writeBytes(file, bytes);
-    expectLoadError(file, expected, "map file format version 3, this orbis reads versions 1 to 2");
+    expectLoadError(file, expected, "map file format version 4, this orbis reads versions 1 to 3");
     fs::remove(file);
   }
+}
+
+// A version 2 file (before the atlas) loads as one map whose first keyframe is the root.
+TEST(MapFile, VersionTwoFilesLoadAsOneMap) {
+  Map map;
+  buildMap(map);
+  const fs::path file = tempFile("version2.map");
+  writeMapFile(file, map, expectation());
+  std::vector<char> bytes = readBytes(file);
+  downgradeToVersionTwo(bytes, map);
+  resealMapFile(bytes);
+  writeBytes(file, bytes);
+  Map loaded;
+  EXPECT_EQ(readMapFile(file, loaded, expectation()).version, 2u);
+  EXPECT_EQ(loaded.keyFrameCount(), map.keyFrameCount());
+  EXPECT_EQ(loaded.mapRecords().size(), 1u);
+  ASSERT_FALSE(loaded.keyFrames().empty());
+  EXPECT_TRUE(loaded.keyFrames().front()->isMapRoot());
+  EXPECT_TRUE(loaded.keyFrames().front()->isGauge());
+  for (const KeyFrame* kf : loaded.keyFrames()) EXPECT_EQ(kf->mapId(), 0u);
+  fs::remove(file);
+}
+
+// An atlas of several maps (one merged away) saves and loads with its maps, roots and active map.
+TEST(MapFile, AtlasOfSeveralMapsRoundTrips) {
+  Map map;
+  buildMap(map);
+  const std::size_t firstMapKeyFrames = map.keyFrameCount();
+  {
+    std::lock_guard lock(map.mutex());
+    map.startNewMap(40);
+    map.startNewMap(50);
+  }
+  buildMap(map);  // into map 2
+  {
+    std::lock_guard lock(map.mutex());
+    map.mergeInto(1, 2);  // map 1 never got a keyframe; merged all the same
+  }
+  const fs::path file = tempFile("atlas.map");
+  writeMapFile(file, map, expectation());
+  Map loaded;
+  EXPECT_EQ(readMapFile(file, loaded, expectation()).version, kMapFileVersion);
+  ASSERT_EQ(loaded.mapRecords().size(), 3u);
+  EXPECT_EQ(loaded.activeMapId(), 2u);
+  EXPECT_EQ(loaded.mapRecords()[2].startFrame, 50u);
+  EXPECT_EQ(loaded.mapRecords()[1].mergedInto, std::optional<std::uint32_t>(2));
+  EXPECT_EQ(loaded.keyFrameCount(0), firstMapKeyFrames);
+  EXPECT_EQ(loaded.keyFrameCount(2), map.keyFrameCount(2));
+  EXPECT_EQ(loaded.mapPointCount(2), map.mapPointCount(2));
+  int roots = 0;
+  for (const KeyFrame* kf : loaded.keyFrames()) roots += kf->isMapRoot() && kf->isGauge();
+  EXPECT_EQ(roots, 2);
+
+  std::vector<char> bytes = readBytes(file);
+  bytes[bytes.size() - 8 - 1] = 7;  // the last keyframe's flags
+  resealMapFile(bytes);
+  writeBytes(file, bytes);
+  expectLoadError(file, expectation(), "impossible keyframe map flags");
+  fs::remove(file);
 }
 
 }  // namespace

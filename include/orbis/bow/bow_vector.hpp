@@ -16,16 +16,24 @@
 
 namespace orbis::bow {
 
+// @{
+// Ids of words (leaves) and nodes of the vocabulary tree, and a word's weight.
 using WordId = std::uint32_t;
 using NodeId = std::uint32_t;
 using WordValue = double;
+// @}
 
+// One word of a bag of words with its weight.
 struct WordEntry {
+  // @{
+  // The word and its weight.
   WordId word;
   WordValue weight;
+  // @}
   friend bool operator==(const WordEntry&, const WordEntry&) = default;
 };
 
+// A bag of words: (word, weight) entries sorted by word, L1-normalised.
 class BowVector {
  public:
   BowVector() = default;
@@ -55,12 +63,15 @@ class BowVector {
     for (WordEntry& e : entries_) e.weight /= sum;
   }
 
+  // @{
+  // Entries: count, emptiness, iteration, one entry, all of them.
   std::size_t size() const { return entries_.size(); }
   bool empty() const { return entries_.empty(); }
   auto begin() const { return entries_.begin(); }
   auto end() const { return entries_.end(); }
   const WordEntry& operator[](std::size_t i) const { return entries_[i]; }
   const std::vector<WordEntry>& entries() const { return entries_; }
+  // @}
 
   // Weight of `word`, 0 when absent.
   WordValue weightOf(WordId word) const {
@@ -106,6 +117,8 @@ inline std::size_t commonWords(const BowVector& a, const BowVector& b) {
   return n;
 }
 
+// Features grouped by vocabulary node (at a fixed level above the words): the groups matching
+// searches compare.
 class FeatureVector {
  public:
   FeatureVector() = default;
@@ -128,6 +141,8 @@ class FeatureVector {
 
   // Number of distinct nodes.
   std::size_t size() const { return nodes_.size(); }
+  // @{
+  // Emptiness, the i-th node, the features under it, every node, and the number of features.
   bool empty() const { return nodes_.empty(); }
   NodeId node(std::size_t i) const { return nodes_[i]; }
   std::span<const std::uint32_t> featuresOf(std::size_t i) const {
@@ -135,6 +150,7 @@ class FeatureVector {
   }
   const std::vector<NodeId>& nodes() const { return nodes_; }
   std::size_t featureCount() const { return features_.size(); }
+  // @}
 
   friend bool operator==(const FeatureVector&, const FeatureVector&) = default;
 

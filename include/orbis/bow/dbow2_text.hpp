@@ -173,6 +173,7 @@ Vocab readDbow2Text(const std::filesystem::path& path) {
                source);
 }
 
+// Writes a vocabulary in DBoW2's text format (ORB-SLAM2's ORBvoc.txt).
 template <class Vocab>
 void writeDbow2Text(const Vocab& vocabulary, const std::filesystem::path& path) {
   using Descriptor = typename Vocab::DescriptorType;

@@ -31,6 +31,7 @@
 
 namespace orbis::bow {
 
+// A keyframe's id in the database.
 using KeyframeId = std::uint64_t;
 
 template <class G>
@@ -41,30 +42,47 @@ concept CovisibilityGraph = requires(const G& g, KeyframeId id, std::size_t n) {
   { g.bestCovisibleKeyframes(id, n) } -> std::ranges::input_range;
 };
 
+// A keyframe proposed by a loop or relocalisation query.
 struct PlaceCandidate {
+  // The keyframe.
   KeyframeId keyframe;
   double accumulatedScore;  // summed over its covisibility group
   double score;             // the keyframe's own score against the query
 };
 
+// A keyframe with its L1 score against a query.
 struct ScoredKeyframe {
+  // @{
+  // The keyframe and its score.
   KeyframeId keyframe;
   double score;
+  // @}
 };
 
+// ORB-SLAM's keyframe database: an inverted index from words to keyframes, with the paper's loop
+// and relocalisation queries (common-word, covisibility-group and score filters).
 class KeyframeDatabase {
  public:
+  // @{
+  // ORB-SLAM's filters: a candidate must share 80 % of the best candidate's common words, its group
+  // score reach 75 % of the best group's; groups are 10 covisible keyframes.
   static constexpr double kCommonWordsRatio = 0.8;
   static constexpr double kGroupScoreRatio = 0.75;
   static constexpr std::size_t kGroupSize = 10;
+  // @}
 
   // Adds or replaces the keyframe's bag of words.
   void add(KeyframeId id, const BowVector& bow);
   // Removes the keyframe; returns false when it was not present.
   bool erase(KeyframeId id);
+  // Removes every keyframe.
   void clear();
+  // @{
+  // Keyframes held, and whether one is.
   std::size_t size() const;
   bool contains(KeyframeId id) const;
+  // @}
+  // A keyframe's bag of words, if held.
   std::optional<BowVector> bowVector(KeyframeId id) const;
 
   // The plain DBoW2 query: the `maxResults` best L1 scores among keyframes sharing a word with
@@ -83,6 +101,8 @@ class KeyframeDatabase {
     return out;
   }
 
+  // Loop candidates for a keyframe: keyframes scoring at least as well as its least similar
+  // covisible one, not connected to it, filtered by group score.
   template <CovisibilityGraph Graph>
   std::vector<PlaceCandidate> detectLoopCandidates(KeyframeId query, const BowVector& bow, const Graph& graph) const {
     std::shared_lock lock(mutex_);
@@ -101,6 +121,7 @@ class KeyframeDatabase {
     return candidates(bow, graph, [&](std::uint32_t slot) { return excluded[slot] != 0; }, minScore);
   }
 
+  // Relocalisation candidates for a frame's bag of words.
   template <CovisibilityGraph Graph>
   std::vector<PlaceCandidate> detectRelocalisationCandidates(const BowVector& bow, const Graph& graph) const {
     std::shared_lock lock(mutex_);

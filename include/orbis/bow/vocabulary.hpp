@@ -37,11 +37,16 @@ concept BinaryDescriptor =
       { d.bytes() } -> std::same_as<std::uint8_t*>;
     };
 
+// A vocabulary tree over binary descriptors (DBoW2's model): k-ary, L levels, memory-mapped from
+// one checksummed block.
 template <BinaryDescriptor Descriptor, DescriptorDistance<Descriptor> Distance>
 class Vocabulary {
  public:
+  // @{
+  // The descriptor and distance types.
   using DescriptorType = Descriptor;
   using DistanceType = Distance;
+  // @}
 
   Vocabulary() = default;
 
@@ -57,11 +62,15 @@ class Vocabulary {
     words_ = blob_.words();
   }
 
+  // Maps and validates a vocabulary file; throws orbis::Error naming the file.
   static Vocabulary load(const std::filesystem::path& path) {
     return Vocabulary(VocabularyBlob::load(path), path.string());
   }
+  // Writes the vocabulary (atomically).
   void save(const std::filesystem::path& path) const { blob_.save(path); }
 
+  // @{
+  // The tree's shape and weighting, and its block.
   bool empty() const { return nodes_ == nullptr; }
   std::uint32_t branching() const { return blob_.info().branching; }
   std::uint32_t depth() const { return blob_.info().depth; }
@@ -70,13 +79,19 @@ class Vocabulary {
   std::size_t wordCount() const { return static_cast<std::size_t>(blob_.info().wordCount); }
   std::size_t nodeCount() const { return static_cast<std::size_t>(blob_.info().nodeCount); }
   const VocabularyBlob& blob() const { return blob_; }
+  // @}
 
+  // @{
+  // A node's descriptor and record, a word's node and weight.
   const Descriptor& nodeDescriptor(NodeId n) const { return descriptors_[n]; }
   const NodeRecord& node(NodeId n) const { return nodes_[n]; }
   NodeId wordNode(WordId w) const { return words_[w].node; }
   float wordWeight(WordId w) const { return words_[w].weight; }
+  // @}
 
+  // Where a descriptor lands: its word and the node levelsUp above it.
   struct Lookup {
+    // The word.
     WordId word;
     NodeId groupNode;  // node at depth L - levelsUp on the path (see the contract above)
   };
@@ -106,8 +121,10 @@ class Vocabulary {
     return {nodes_[n].wordId, group};
   }
 
+  // The word a descriptor falls into.
   WordId wordOf(const Descriptor& d) const { return lookup(d).word; }
 
+  // The bag of words of a set of descriptors.
   BowVector transform(std::span<const Descriptor> descriptors) const {
     if (empty()) return {};
     std::vector<WordEntry> entries;
@@ -140,6 +157,7 @@ class Vocabulary {
     features = FeatureVector::fromPairs(std::move(groups));
   }
 
+  // The L1 similarity of two bags of words, in [0, 1].
   double score(const BowVector& a, const BowVector& b) const { return l1Score(a, b); }
 
  private:
@@ -157,6 +175,7 @@ class Vocabulary {
   const WordRecord* words_ = nullptr;
 };
 
+// The vocabulary of ORB descriptors the pipeline uses.
 using OrbVocabulary = Vocabulary<OrbDescriptor, HammingDistance>;
 
 }  // namespace orbis::bow

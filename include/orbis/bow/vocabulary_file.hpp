@@ -26,15 +26,21 @@ namespace orbis::bow {
 
 // Numeric codes are DBoW2's, so its text files convert without a table.
 enum class Weighting : std::uint32_t { TfIdf = 0, Tf = 1, Idf = 2, Binary = 3 };
+// How bags of words are compared.
 enum class Scoring : std::uint32_t { L1 = 0 };  // the only scoring ORB-SLAM uses
 
+// "tf-idf", "tf", "idf" or "binary".
 std::string_view weightingName(Weighting w);
 std::optional<Weighting> parseWeighting(std::string_view name);  // "tf-idf", "tf", "idf", "binary"
 
+// @{
+// Markers: an inner node (no word) and the root (no parent).
 inline constexpr std::uint32_t kNoWord = 0xFFFFFFFFu;
 inline constexpr std::uint32_t kNoParent = 0xFFFFFFFFu;
+// @}
 inline constexpr std::uint32_t kBinaryDescriptorKind = 1;  // bit strings compared by Hamming distance
 
+// One node of the tree as stored.
 struct NodeRecord {
   std::uint32_t firstChild;  // index of the first child; children are [firstChild, firstChild+childCount)
   std::uint32_t childCount;  // 0 for a leaf (a word)
@@ -43,29 +49,38 @@ struct NodeRecord {
 };
 static_assert(sizeof(NodeRecord) == 16);
 
+// One word as stored.
 struct WordRecord {
+  // Its node.
   std::uint32_t node;
   float weight;  // IDF weight (or 1 for TF / binary weighting)
 };
 static_assert(sizeof(WordRecord) == 8);
 
+// The tree's shape and weighting, as the file's header holds them.
 struct VocabularyInfo {
   std::uint32_t branching = 0;  // k
   std::uint32_t depth = 0;      // L
+  // @{
+  // Weighting, scoring, descriptor kind and size, node and word counts.
   Weighting weighting = Weighting::TfIdf;
   Scoring scoring = Scoring::L1;
   std::uint32_t descriptorKind = kBinaryDescriptorKind;
   std::uint32_t descriptorBytes = 0;
   std::uint64_t nodeCount = 0;
   std::uint64_t wordCount = 0;
+  // @}
 };
 
+// The vocabulary file format's version.
 inline constexpr std::uint32_t kVocabularyFormatVersion = 1;
 
 // Fast 64-bit non-cryptographic checksum (4 independent multiply-rotate lanes, ~10 GB/s), so
 // verifying a 40 MB vocabulary costs a few milliseconds.
 std::uint64_t checksum64(const void* data, std::size_t size, std::uint64_t seed = 0);
 
+// A vocabulary file mapped into memory in one block (header, descriptors, nodes, words), checked
+// against its checksum.
 class VocabularyBlob {
  public:
   VocabularyBlob() = default;
@@ -82,12 +97,15 @@ class VocabularyBlob {
   // Writes the block byte for byte (atomically: a temporary file renamed into place).
   void save(const std::filesystem::path& path) const;
 
+  // @{
+  // Whether a block is held, its header, and its parts.
   bool valid() const { return data_ != nullptr; }
   const VocabularyInfo& info() const { return info_; }
   const std::byte* descriptorBytes() const { return data_.get() + descriptorsOffset_; }
   const NodeRecord* nodes() const { return reinterpret_cast<const NodeRecord*>(data_.get() + nodesOffset_); }
   const WordRecord* words() const { return reinterpret_cast<const WordRecord*>(data_.get() + wordsOffset_); }
   std::span<const std::byte> bytes() const { return {data_.get(), size_}; }
+  // @}
 
  private:
   // Checks header, sizes, checksum and structure of `size` bytes at `data`; fills the offsets.

@@ -23,12 +23,17 @@
 
 namespace orbis::bow {
 
+// How a vocabulary is trained (orbis vocab train).
 struct TrainingParams {
   std::uint32_t branching = 10;  // k
   std::uint32_t depth = 5;       // L
+  // @{
+  // Weighting, seed of the k-means++ seeding, and worker threads (the result is the same at any
+  // count).
   Weighting weighting = Weighting::TfIdf;
   std::uint64_t seed = 1;
   unsigned threads = 1;
+  // @}
   int maxIterations = 30;  // Lloyd iterations per node; most nodes converge well before
   // Called from one thread at a time with (descriptor-levels done, total); may be empty.
   std::function<void(std::size_t, std::size_t)> progress;

@@ -60,12 +60,17 @@ const PinholeCamera<typename C::Scalar>& pinholeOf(const C& camera) {
   }
 }
 
+// What the pipeline asks of any camera model, in one place.
 template <CameraModel C>
 struct CameraTraits {
+  // @{
+  // The camera's scalar, its observation type and size, and whether it measures metric depth.
   using Scalar = typename C::Scalar;
   using Observation = Eigen::Matrix<Scalar, C::kObservationDim, 1>;
   static constexpr int kObservationDim = C::kObservationDim;
   static constexpr bool kMetricDepth = C::kMetricDepth;
+  // @}
+  // Depth below which a point counts as close (stereo-measured).
   static Scalar closeDepthThreshold(const C& camera) { return camera.closeDepthThreshold(); }
 };
 

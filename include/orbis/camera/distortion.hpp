@@ -19,15 +19,25 @@
 
 namespace orbis {
 
+// Radial-tangential (Brown–Conrady, OpenCV's k1 k2 p1 p2 k3) lens distortion on normalised image
+// coordinates.
 template <class S = double>
 struct RadTanDistortion {
+  // @{
+  // Vector and Jacobian types of the normalised image plane.
   using Vector2 = Eigen::Matrix<S, 2, 1>;
   using Matrix2 = Eigen::Matrix<S, 2, 2>;
+  // @}
 
+  // @{
+  // The coefficients (settings Camera.k1, k2, p1, p2, k3).
   S k1{}, k2{}, p1{}, p2{}, k3{};
+  // @}
 
+  // Whether the lens has no distortion (the images are already undistorted).
   bool isZero() const { return k1 == S(0) && k2 == S(0) && p1 == S(0) && p2 == S(0) && k3 == S(0); }
 
+  // The distorted normalised point of an undistorted one.
   Vector2 distort(const Vector2& xn) const {
     const S x = xn.x(), y = xn.y();
     const S r2 = x * x + y * y;
@@ -63,18 +73,21 @@ struct RadTanDistortion {
     return x;
   }
 
+  // The same distortion in another scalar type.
   template <class T>
   RadTanDistortion<T> cast() const {
     return {T(k1), T(k2), T(p1), T(p2), T(k3)};
   }
 };
 
+// The undistorted pixel of a pixel of the distorted image.
 template <class S>
 Eigen::Matrix<S, 2, 1> undistortPixel(const PinholeCamera<S>& camera, const RadTanDistortion<S>& lens,
                                       const Eigen::Matrix<S, 2, 1>& px) {
   return camera.normalizedToPixel(lens.undistort(camera.pixelToNormalized(px)));
 }
 
+// The distorted pixel of an undistorted one.
 template <class S>
 Eigen::Matrix<S, 2, 1> distortPixel(const PinholeCamera<S>& camera, const RadTanDistortion<S>& lens,
                                     const Eigen::Matrix<S, 2, 1>& px) {

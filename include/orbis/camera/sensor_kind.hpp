@@ -12,12 +12,15 @@
 
 namespace orbis {
 
+// The three sensor families: one camera, a rectified stereo pair, a colour camera with a depth
+// sensor.
 enum class SensorKind { Monocular, Stereo, Rgbd };
 
 // source and where name the origin in the error, as orbis::Error does: a file and "key Sensor",
 // or "argument --sensor" and nothing.
 SensorKind parseSensorKind(std::string_view name, const std::string& source = "sensor",
                            const std::string& where = "");
+// "mono", "stereo" or "rgbd".
 std::string_view toString(SensorKind sensor);
 
 }  // namespace orbis

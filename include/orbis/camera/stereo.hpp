@@ -73,8 +73,11 @@ struct StereoGeometry {
 
 }  // namespace detail
 
+// A rectified stereo pair: observation (uL, v, uR) with uR = uL − bf/Z; points nearer than
+// closeDepth (ThDepth baselines) are close.
 template <class S = double>
 struct RectifiedStereoCamera : detail::StereoGeometry<S> {
+  // The shared stereo geometry (projection, Jacobian, unprojection).
   using Base = detail::StereoGeometry<S>;
 
   // A rectified pair measures depth through a disparity of a few pixels for far points (beyond
@@ -85,19 +88,25 @@ struct RectifiedStereoCamera : detail::StereoGeometry<S> {
   static constexpr bool kFarDepthMonocular = true;
 
   RectifiedStereoCamera() = default;
+  // A pair with the given baseline (metres) and ORB-SLAM2's close depth of 40 baselines.
   RectifiedStereoCamera(const PinholeCamera<S>& pinhole, S baseline)
       : Base(pinhole, baseline, Base::kDefaultCloseDepthInBaselines * baseline) {}
+  // A pair with the given baseline and close depth (metres).
   RectifiedStereoCamera(const PinholeCamera<S>& pinhole, S baseline, S closeDepth)
       : Base(pinhole, baseline, closeDepth) {}
 
+  // The same camera in another scalar type.
   template <class T>
   RectifiedStereoCamera<T> cast() const {
     return {this->pinhole.template cast<T>(), T(this->baseline), T(this->closeDepth)};
   }
 };
 
+// A colour camera with a depth sensor, observed like a stereo pair through a virtual baseline: a
+// depth reading d becomes uR = uL − bf/d.
 template <class S = double>
 struct RgbdCamera : detail::StereoGeometry<S> {
+  // The shared stereo geometry (projection, Jacobian, unprojection).
   using Base = detail::StereoGeometry<S>;
 
   // σ of the virtual disparity bf/d in pixels, beside a level-0 keypoint's 1 px (settings
@@ -106,15 +115,20 @@ struct RgbdCamera : detail::StereoGeometry<S> {
   static constexpr S kDefaultDisparitySigma = S(0.125);
 
   S depthScale = S(1);  // settings DepthMapFactor: raw depth value / depthScale = metres
+  // σ of the virtual disparity, px (settings DepthDisparitySigma).
   S disparitySigma = kDefaultDisparitySigma;
 
   RgbdCamera() = default;
+  // A depth camera with ORB-SLAM2's close depth of 40 virtual baselines; depthScaleFactor: raw
+  // depth per metre.
   RgbdCamera(const PinholeCamera<S>& pinhole, S virtualBaseline, S depthScaleFactor)
       : Base(pinhole, virtualBaseline, Base::kDefaultCloseDepthInBaselines * virtualBaseline),
         depthScale(depthScaleFactor) {}
+  // A depth camera with the given close depth (metres).
   RgbdCamera(const PinholeCamera<S>& pinhole, S virtualBaseline, S depthScaleFactor, S closeDepth)
       : Base(pinhole, virtualBaseline, closeDepth), depthScale(depthScaleFactor) {}
 
+  // Metres of a raw depth-image value.
   S metricDepth(S rawDepth) const { return rawDepth / depthScale; }
 
   // The stereo observation a depth reading d (metres) at (uL, v) stands for.
@@ -122,6 +136,7 @@ struct RgbdCamera : detail::StereoGeometry<S> {
     return {uL, v, uL - this->bf() / depth};
   }
 
+  // The same camera in another scalar type.
   template <class T>
   RgbdCamera<T> cast() const {
     RgbdCamera<T> c{this->pinhole.template cast<T>(), T(this->baseline), T(depthScale), T(this->closeDepth)};

@@ -20,20 +20,26 @@
 
 namespace orbis::eval {
 
+// One associated pair of poses: indices into the ground truth and the estimate.
 struct PosePair {
   std::size_t groundTruth;  // index into the ground-truth trajectory
   std::size_t estimate;     // index into the estimated trajectory
 };
 
+// Pairs each estimate pose with the ground-truth pose nearest in time, one-to-one, within maxDt
+// seconds (the TUM benchmark's and evo's association).
 std::vector<PosePair> associateByTime(const Trajectory& groundTruth, const Trajectory& estimate,
                                       double maxDt);
 
 // Pairs by index, for trajectories that share frames (KITTI): requires equal sizes.
 std::vector<PosePair> associateByIndex(const Trajectory& groundTruth, const Trajectory& estimate);
 
+// How an estimate is aligned to the ground truth before errors are measured: not at all, by a rigid
+// motion, or by a similarity (monocular).
 enum class Alignment { None, SE3, Sim3 };
 // "none", "se3" or "sim3"; throws orbis::Error(source) otherwise.
 Alignment parseAlignment(std::string_view name, const std::string& source = "alignment");
+// "none", "se3" or "sim3".
 std::string_view toString(Alignment alignment);
 
 // source and target are 3xN with the same N (>= 1).

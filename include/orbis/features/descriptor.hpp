@@ -13,19 +13,30 @@
 
 namespace orbis {
 
+// A 256-bit ORB (rotated BRIEF) descriptor, as four 64-bit words.
 struct OrbDescriptor {
+  // @{
+  // Its size in bits and bytes.
   static constexpr int kBits = 256;
   static constexpr int kBytes = 32;
+  // @}
+  // The bits, little-endian within each word.
   std::array<std::uint64_t, 4> words{};
 
+  // @{
+  // The 32 bytes, in OpenCV's descriptor-row order.
   const std::uint8_t* bytes() const { return reinterpret_cast<const std::uint8_t*>(words.data()); }
   std::uint8_t* bytes() { return reinterpret_cast<std::uint8_t*>(words.data()); }
+  // @}
+  // @{
+  // Reads or sets bit i.
   bool bit(int i) const { return (words[static_cast<std::size_t>(i >> 6)] >> (i & 63)) & 1u; }
   void setBit(int i, bool v) {
     const std::uint64_t m = std::uint64_t{1} << (i & 63);
     auto& w = words[static_cast<std::size_t>(i >> 6)];
     w = v ? (w | m) : (w & ~m);
   }
+  // @}
   // From the 32 bytes of an OpenCV descriptor row (CV_8U, 32 columns).
   static OrbDescriptor fromBytes(const std::uint8_t* src) {
     OrbDescriptor d;
@@ -35,6 +46,7 @@ struct OrbDescriptor {
   friend bool operator==(const OrbDescriptor&, const OrbDescriptor&) = default;
 };
 
+// The number of differing bits (POPCNT where the build enables it).
 inline int hammingDistance(const OrbDescriptor& a, const OrbDescriptor& b) {
   return std::popcount(a.words[0] ^ b.words[0]) + std::popcount(a.words[1] ^ b.words[1]) +
          std::popcount(a.words[2] ^ b.words[2]) + std::popcount(a.words[3] ^ b.words[3]);
@@ -50,9 +62,13 @@ concept DescriptorDistance = std::default_initializable<P> && requires(const P p
 
 // The distance policy of binary descriptors.
 struct HammingDistance {
+  // @{
+  // The descriptor type, its distance type and the largest distance.
   using Descriptor = OrbDescriptor;
   using Distance = int;
   static constexpr int kMax = OrbDescriptor::kBits;
+  // @}
+  // The Hamming distance of a and b.
   int operator()(const OrbDescriptor& a, const OrbDescriptor& b) const { return hammingDistance(a, b); }
 };
 static_assert(DescriptorDistance<HammingDistance, OrbDescriptor>);

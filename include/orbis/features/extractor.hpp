@@ -38,19 +38,27 @@ concept FeatureExtractor = requires(E& e, const E& ce, const cv::Mat& image,
 // The pyramid description and accessors both ORB extractors share.
 class PyramidExtractorBase {
  public:
+  // Keeps the parameters and the pyramid's scales.
   explicit PyramidExtractorBase(const OrbParams& params)
       : params_(params), scales_(params.levels, params.scaleFactor) {}
+  // @{
+  // The pyramid's levels, per-level scale factors and σ², the scales, the last image's pyramid and
+  // the parameters.
   int levels() const { return scales_.levels(); }
   std::span<const float> scaleFactors() const { return scales_.scale; }
   std::span<const float> levelSigma2() const { return scales_.sigma2; }
   const ScaleLevels& scaleLevels() const { return scales_; }
   std::span<const cv::Mat> pyramid() const { return pyramid_.images(); }
   const OrbParams& params() const { return params_; }
+  // @}
 
  protected:
+  // @{
+  // The parameters, scales and pyramid the derived extractor fills.
   OrbParams params_;
   ScaleLevels scales_;
   ImagePyramid pyramid_;
+  // @}
 };
 
 namespace detail {

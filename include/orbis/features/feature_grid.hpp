@@ -18,11 +18,16 @@
 
 namespace orbis {
 
+// Keypoints binned into a 64 × 48 grid over the image, for area queries.
 class FeatureGrid {
  public:
+  // @{
+  // Grid size.
   static constexpr int kCols = 64;
   static constexpr int kRows = 48;
+  // @}
 
+  // Bins keypoints over the undistorted image bounds [minX, maxX) × [minY, maxY).
   void build(std::span<const Keypoint> keypoints, float minX, float maxX, float minY, float maxY) {
     minX_ = minX;
     minY_ = minY;
@@ -48,6 +53,8 @@ class FeatureGrid {
     }
   }
 
+  // Appends the keypoints within radius r of (u, v) whose level lies in [minLevel, maxLevel] (−1:
+  // any).
   void featuresInArea(float u, float v, float r, int minLevel, int maxLevel, std::vector<int>& out) const {
     out.clear();
     if (entries_.empty()) return;
@@ -68,6 +75,7 @@ class FeatureGrid {
     }
   }
 
+  // The keypoints within radius r of (u, v) whose level lies in [minLevel, maxLevel] (−1: any).
   std::vector<int> featuresInArea(float u, float v, float r, int minLevel = -1, int maxLevel = -1) const {
     std::vector<int> out;
     featuresInArea(u, v, r, minLevel, maxLevel, out);
@@ -80,11 +88,16 @@ class FeatureGrid {
     if (!(cx >= 0.f && cx < kCols && cy >= 0.f && cy < kRows)) return -1;
     return static_cast<int>(cy) * kCols + static_cast<int>(cx);
   }
+  // Whether (u, v) lies inside the bounds.
   bool inBounds(float u, float v) const { return u >= minX_ && u < maxX_ && v >= minY_ && v < maxY_; }
+  // @{
+  // The bounds.
   float minX() const { return minX_; }
   float maxX() const { return maxX_; }
   float minY() const { return minY_; }
   float maxY() const { return maxY_; }
+  // @}
+  // Keypoints in a cell.
   int cellCount(int cell) const {
     return cellStart_.empty() ? 0 : cellStart_[static_cast<std::size_t>(cell) + 1] - cellStart_[static_cast<std::size_t>(cell)];
   }

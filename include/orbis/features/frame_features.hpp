@@ -31,24 +31,38 @@
 
 namespace orbis {
 
+// How a keypoint enters the map and BA: no depth, close stereo/depth, or far (beyond ThDepth).
 enum class KeypointKind { Monocular, Close, Far };
 
+// One frame's features: keypoints, descriptors, stereo coordinates, depths and an area index.
 struct FrameFeatures {
+  // Keypoints as detected.
   std::vector<Keypoint> keypoints;
+  // The same, undistorted.
   std::vector<Keypoint> keypointsUn;
+  // One descriptor per keypoint.
   std::vector<OrbDescriptor> descriptors;
+  // Right-image coordinate per keypoint, or −1 when it has no stereo partner or depth.
   std::vector<float> uRight;
+  // Depth per keypoint (metres), or −1.
   std::vector<float> depth;
+  // Depth below which a keypoint is close.
   float closeDepth = std::numeric_limits<float>::infinity();
+  // The pyramid's scales.
   ScaleLevels scales;
+  // Area index over the undistorted keypoints.
   FeatureGrid grid;
 
+  // Number of keypoints.
   std::size_t size() const { return keypoints.size(); }
+  // Whether keypoint i has a depth.
   bool hasDepth(std::size_t i) const { return depth[i] > 0.f; }
+  // Monocular, close or far.
   KeypointKind kind(std::size_t i) const {
     if (!hasDepth(i)) return KeypointKind::Monocular;
     return depth[i] < closeDepth ? KeypointKind::Close : KeypointKind::Far;
   }
+  // Keypoints with a stereo partner or depth.
   std::size_t stereoCount() const;
 };
 
@@ -64,6 +78,7 @@ void finishMonocular(FrameFeatures& f, const PinholeCamera<double>& camera,
 void assignDepth(FrameFeatures& f, const cv::Mat& depthImage, double depthScale, double bf);
 }  // namespace detail
 
+// Features of a monocular image: keypoints undistorted with the lens, no depth.
 template <FeatureExtractor E>
 FrameFeatures extractMonocular(E& extractor, const cv::Mat& image, const PinholeCamera<double>& camera,
                                const RadTanDistortion<double>& lens = {}) {
@@ -101,6 +116,7 @@ FrameFeatures extractStereo(E& leftExtractor, E& rightExtractor, const cv::Mat& 
   return f;
 }
 
+// Features of an RGB-D frame: keypoints on the colour image, depth read at each.
 template <FeatureExtractor E>
 FrameFeatures extractRgbd(E& extractor, const cv::Mat& image, const cv::Mat& depthImage,
                           const RgbdCamera<double>& camera, const RadTanDistortion<double>& lens = {}) {

@@ -22,27 +22,38 @@ namespace orbis {
 // uses the nominal factor instead of the rounded level size: on 640x480 its keypoints of the
 // coarse levels land up to 1.8 px from where the level's image puts them (image_pyramid_test).
 struct PyramidLevelMap {
+  // Level-0 pixels per level pixel, along x and y.
   float sx = 1.f, sy = 1.f;  // level-0 pixels per level pixel, along x and y
 
+  // The map between two images of a pyramid.
   static PyramidLevelMap between(const cv::Mat& base, const cv::Mat& level) {
     return {static_cast<float>(base.cols) / static_cast<float>(level.cols),
             static_cast<float>(base.rows) / static_cast<float>(level.rows)};
   }
+  // @{
+  // Between level-0 and level coordinates, pixel centres aligned.
   float toBaseX(float x) const { return (x + 0.5f) * sx - 0.5f; }
   float toBaseY(float y) const { return (y + 0.5f) * sy - 0.5f; }
   float fromBaseX(float x) const { return (x + 0.5f) / sx - 0.5f; }
   float fromBaseY(float y) const { return (y + 0.5f) / sy - 0.5f; }
+  // @}
 };
 
+// The scaled images of a frame, with a border for the descriptor's patch.
 class ImagePyramid {
  public:
+  // Border width, pixels.
   static constexpr int kBorder = 19;
 
+  // Builds every level from an 8-bit grey image.
   void build(const cv::Mat& gray8u, const ScaleLevels& levels);
+  // @{
+  // The levels (without border), one level, all of them, and a level's coordinate map.
   int levels() const { return static_cast<int>(interior_.size()); }
   const cv::Mat& level(int l) const { return interior_[static_cast<std::size_t>(l)]; }
   std::span<const cv::Mat> images() const { return interior_; }
   PyramidLevelMap levelMap(int l) const { return PyramidLevelMap::between(level(0), level(l)); }
+  // @}
 
   // Refills the reflected border of a bordered buffer from its interior.
   static void fillBorder(cv::Mat& bordered, int border);

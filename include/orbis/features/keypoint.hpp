@@ -15,24 +15,35 @@
 
 namespace orbis {
 
+// A detected keypoint.
 struct Keypoint {
+  // @{
+  // Pixel coordinates.
   float u = 0.f, v = 0.f;
+  // @}
   float angle = 0.f;     // degrees, [0, 360)
   float response = 0.f;  // detector score; larger is stronger
   int octave = 0;        // pyramid level
 };
 
+// As an OpenCV keypoint.
 inline cv::KeyPoint toCvKeyPoint(const Keypoint& k, float size = 31.f) {
   return {k.u, k.v, size, k.angle, k.response, k.octave};
 }
+// From an OpenCV keypoint.
 inline Keypoint fromCvKeyPoint(const cv::KeyPoint& k) {
   return {k.pt.x, k.pt.y, k.angle, k.response, k.octave};
 }
 
+// Per pyramid level: scale, its inverse, σ² of a keypoint's position and its inverse.
 struct ScaleLevels {
+  // @{
+  // Per-level values.
   std::vector<float> scale, invScale, sigma2, invSigma2;
+  // @}
 
   ScaleLevels() : ScaleLevels(1, 1.f) {}
+  // levels levels, each factor times the previous.
   ScaleLevels(int levels, float factor) {
     const auto n = static_cast<std::size_t>(levels < 1 ? 1 : levels);
     scale.resize(n);
@@ -47,7 +58,9 @@ struct ScaleLevels {
       invSigma2[l] = 1.f / (s * s);
     }
   }
+  // Number of levels.
   int levels() const { return static_cast<int>(scale.size()); }
+  // Scale ratio between levels.
   float factor() const { return scale.size() > 1 ? scale[1] : 1.f; }
   // log(ratio)/log(factor): used to predict the level at which a point of a given distance
   // is seen (ORB-SLAM's PredictScale).

@@ -42,19 +42,28 @@
 namespace orbis {
 
 namespace matching {
+// @{
+// ORB-SLAM's descriptor distance thresholds (high, low) and nearest-neighbour ratios (loose,
+// strict).
 inline constexpr int kThHigh = 100;
 inline constexpr int kThLow = 50;
 inline constexpr float kRatioLoose = 0.9f;
 inline constexpr float kRatioStrict = 0.75f;
+// @}
 // Chi-square 95% quantile, 1 degree of freedom: the epipolar-line test.
 inline constexpr double kEpipolarChi2 = 3.84;
 }  // namespace matching
 
+// A map point's prediction in a frame, for a search by projection.
 struct ProjectionQuery {
+  // @{
+  // Predicted pixel.
   float u = 0, v = 0;    // predicted undistorted pixel
+  // @}
   float uRight = -1.f;   // predicted right coordinate; < 0 for none
   int octave = 0;        // predicted pyramid level
   float viewCos = 1.f;   // cosine between this view's ray and the point's mean viewing direction
+  // The point's descriptor.
   OrbDescriptor descriptor;
 };
 
@@ -68,10 +77,17 @@ inline std::vector<std::uint8_t> takenMask(std::span<const std::uint8_t> taken, 
 
 // The two keypoints nearest to a query descriptor; best < 0 when no candidate was compared.
 struct NearestTwo {
+  // Index of the best keypoint, or −1.
   long best = -1;
+  // @{
+  // Distances of the best and second-best keypoints.
   int bestDistance = std::numeric_limits<int>::max();
   int secondDistance = std::numeric_limits<int>::max();
+  // @}
+  // @{
+  // Levels of the best and second-best (−1 for none).
   int bestOctave = -1, secondOctave = -1;  // -1 for none
+  // @}
 };
 
 // The nearest and second-nearest keypoints of `features` to `query` among `candidates`

@@ -20,10 +20,13 @@
 
 namespace orbis {
 
+// cv::ORB behind the FeatureExtractor interface: a reference to measure OrbExtractor against.
 class OpenCvOrbExtractor : public PyramidExtractorBase {
  public:
+  // An extractor with ORB-SLAM's parameters.
   explicit OpenCvOrbExtractor(const OrbParams& params = {});
 
+  // Keypoints and descriptors of an 8-bit image.
   void extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                std::vector<OrbDescriptor>& descriptors);
 

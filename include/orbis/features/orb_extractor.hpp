@@ -28,25 +28,36 @@
 
 namespace orbis {
 
+// ORB-SLAM's extractor: FAST on every level with a fallback threshold per cell, a quadtree keeping
+// the strongest corner per node, intensity-centroid orientation, rotated BRIEF.
 class OrbExtractor : public PyramidExtractorBase {
  public:
+  // @{
+  // The descriptor's patch and half of it.
   static constexpr int kPatchSize = 31;
   static constexpr int kHalfPatch = 15;
+  // @}
   static constexpr int kEdge = 19;        // keypoints keep this far from each level's edge (ORB-SLAM)
   static constexpr int kCellSize = 30;    // FAST fallback cells, level pixels
   // Gaussian applied before the binary tests (ORB-SLAM: 7x7, sigma 2), as the 8-bit fixed-point
   // taps (sum 256) that cv::GaussianBlur quantises it to on a whole image, as in ORB-SLAM2.
   static constexpr int kBlurSize = 7;
+  // @{
+  // The blur's σ and its fixed-point taps.
   static constexpr double kBlurSigma = 2.0;
   static constexpr std::array<int, kBlurSize> kBlurTapsQ8 = {18, 34, 48, 56, 48, 34, 18};
+  // @}
 
+  // An extractor with the given budget, levels and thresholds.
   explicit OrbExtractor(const OrbParams& params = {});
 
   // One row of the orientation circle as a byte mask over u = -16..15.
   struct CircleRowMask {
+    // The mask bytes.
     alignas(16) std::uint8_t bytes[32];
   };
 
+  // Keypoints and descriptors of an 8-bit grey or BGR image.
   void extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                std::vector<OrbDescriptor>& descriptors);
 

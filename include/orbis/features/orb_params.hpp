@@ -7,6 +7,7 @@
 
 namespace orbis {
 
+// The extractor's parameters (settings ORBextractor.*).
 struct OrbParams {
   int features = 1000;       // total keypoint budget over all pyramid levels
   float scaleFactor = 1.2f;  // ratio between consecutive pyramid levels

@@ -15,14 +15,19 @@
 
 namespace orbis {
 
+// ORB-SLAM's orientation consistency check: matches binned by their keypoints' angle difference;
+// only the three fullest bins are kept.
 class RotationHistogram {
  public:
+  // Bins over 360°.
   static constexpr int kBins = 30;
 
+  // Empties the bins.
   void clear() {
     for (auto& b : bins_) b.clear();
   }
 
+  // Adds a match by its angle difference.
   void add(float angleDifferenceDeg, int item) {
     float a = std::fmod(angleDifferenceDeg, 360.f);
     if (a < 0.f) a += 360.f;

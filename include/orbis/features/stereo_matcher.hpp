@@ -24,12 +24,18 @@
 
 namespace orbis {
 
+// One image of a stereo pair: its keypoints, descriptors and pyramid.
 struct StereoView {
+  // @{
+  // Keypoints, descriptors and pyramid levels.
   std::span<const Keypoint> keypoints;
   std::span<const OrbDescriptor> descriptors;
   std::span<const cv::Mat> pyramid;
+  // @}
 };
 
+// ORB-SLAM2's stereo matching along rows: descriptor match, then an 11×11 patch slid along the row
+// (zero-mean SAD) and a parabola fit, then outliers by median distance.
 class StereoMatcher {
  public:
   // ORB-SLAM2: (TH_HIGH + TH_LOW) / 2.
@@ -37,6 +43,7 @@ class StereoMatcher {
   static constexpr int kPatchHalf = 5;   // 11x11 correlation window
   static constexpr int kSlide = 5;       // +-5 px search around the descriptor match
   static constexpr float kRowBand = 2.f; // row tolerance, times the right keypoint's scale
+  // Matches whose patch cost exceeds this × the median are dropped.
   static constexpr float kOutlierFactor = 1.5f * 1.4f;
 
   // bf = focal length x baseline (pixels x metres); minDepth bounds the disparity (ORB-SLAM:

@@ -14,9 +14,13 @@
 
 namespace orbis {
 
+// A rigid motion: rotation and translation, acting on points as R·p + t (Sophus' conventions;
+// tangent ordered (υ, ω)).
 template <class S>
 class SE3 {
  public:
+  // @{
+  // The scalar, the sizes and the Eigen types of the group, its tangent space and its matrices.
   using Scalar = S;
   static constexpr int kDoF = 6;
   static constexpr int kMatrixDim = 4;
@@ -30,14 +34,18 @@ class SE3 {
   using Transformation = Matrix4;
   using AdjointMatrix = Matrix6;
   using Quaternion = Eigen::Quaternion<S>;
+  // @}
 
   SE3() : translation_(Vector3::Zero()) {}
+  // @{
+  // A motion from its rotation (SO3, unit quaternion or rotation matrix) and translation.
   SE3(const SO3<S>& rotation, const Vector3& translation)
       : so3_(rotation), translation_(translation) {}
   SE3(const Quaternion& rotation, const Vector3& translation)
       : so3_(rotation), translation_(translation) {}
   SE3(const Matrix3& rotation, const Vector3& translation)
       : so3_(rotation), translation_(translation) {}
+  // @}
 
   // Reads the top 3x4 block; the bottom row is ignored. The rotation block is re-normalised.
   template <class Derived>
@@ -49,11 +57,13 @@ class SE3 {
                Vector3(m.template block<3, 1>(0, 3).template cast<S>()));
   }
 
+  // The motion of a tangent vector (υ, ω).
   static SE3 exp(const Tangent& xi) {
     const Vector3 omega = xi.template tail<3>();
     return SE3(SO3<S>::exp(omega), SO3<S>::leftJacobian(omega) * xi.template head<3>());
   }
 
+  // The tangent vector of this motion; exp(log()) is the identity for rotations below π.
   Tangent log() const {
     const Vector3 omega = so3_.log();
     Tangent xi;
@@ -69,6 +79,7 @@ class SE3 {
     m.template block<3, 1>(0, 3) = xi.template head<3>();
     return m;
   }
+  // The tangent vector of a 4×4 Lie-algebra matrix.
   static Tangent vee(const Matrix4& m) {
     Tangent xi;
     xi.template head<3>() = m.template block<3, 1>(0, 3);
@@ -76,22 +87,29 @@ class SE3 {
     return xi;
   }
 
+  // The inverse motion.
   SE3 inverse() const {
     const SO3<S> inv = so3_.inverse();
     return SE3(inv, -(inv * translation_));
   }
 
+  // @{
+  // Composition: (this · other)(p) = this(other(p)).
   SE3 operator*(const SE3& other) const {
     return SE3(so3_ * other.so3_, so3_ * other.translation_ + translation_);
   }
   SE3& operator*=(const SE3& other) { return *this = *this * other; }
+  // @}
+  // The motion applied to a point: R·p + t.
   Point operator*(const Point& p) const { return so3_ * p + translation_; }
 
+  // The 4×4 homogeneous matrix.
   Matrix4 matrix() const {
     Matrix4 m = Matrix4::Identity();
     m.template block<3, 4>(0, 0) = matrix3x4();
     return m;
   }
+  // The top 3×4 block [R | t].
   Matrix3x4 matrix3x4() const {
     Matrix3x4 m;
     m.template block<3, 3>(0, 0) = so3_.matrix();
@@ -110,6 +128,8 @@ class SE3 {
     return a;
   }
 
+  // @{
+  // The rotation and the translation, read and set.
   const SO3<S>& so3() const { return so3_; }
   SO3<S>& so3() { return so3_; }
   Matrix3 rotationMatrix() const { return so3_.matrix(); }
@@ -118,8 +138,11 @@ class SE3 {
   Vector3& translation() { return translation_; }
   void setRotation(const SO3<S>& rotation) { so3_ = rotation; }
   void setTranslation(const Vector3& translation) { translation_ = translation; }
+  // @}
+  // Renormalises the rotation's quaternion after many compositions.
   void normalize() { so3_.normalize(); }
 
+  // The left Jacobian of exp: exp(ξ + δ) ≈ exp(J_l(ξ)·δ)·exp(ξ).
   static Matrix6 leftJacobian(const Tangent& xi) {
     const Vector3 omega = xi.template tail<3>();
     const Matrix3 J = SO3<S>::leftJacobian(omega);
@@ -142,8 +165,11 @@ class SE3 {
     out.template block<3, 3>(3, 3) = Jinv;
     return out;
   }
+  // @{
+  // The right Jacobian of exp and its inverse: exp(ξ + δ) ≈ exp(ξ)·exp(J_r(ξ)·δ).
   static Matrix6 rightJacobian(const Tangent& xi) { return leftJacobian(-xi); }
   static Matrix6 rightJacobianInverse(const Tangent& xi) { return leftJacobianInverse(-xi); }
+  // @}
 
   // d(exp(δ)·q)/dδ at δ = 0 for the transformed point q = T·p: [I, −hat(q)].
   static Eigen::Matrix<S, 3, 6> pointJacobianLeft(const Point& transformedPoint) {
@@ -153,6 +179,7 @@ class SE3 {
     return j;
   }
 
+  // The same motion in another scalar type.
   template <class T>
   SE3<T> cast() const {
     return SE3<T>(so3_.template cast<T>(), translation_.template cast<T>());
@@ -194,7 +221,10 @@ class SE3 {
   Vector3 translation_;
 };
 
+// @{
+// SE3 in double and float.
 using SE3d = SE3<double>;
 using SE3f = SE3<float>;
+// @}
 
 }  // namespace orbis

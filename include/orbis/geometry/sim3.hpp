@@ -17,9 +17,13 @@
 
 namespace orbis {
 
+// A similarity: scale, rotation and translation, acting on points as s·R·p + t (Sophus'
+// conventions; tangent ordered (υ, ω, σ), scale exp(σ)).
 template <class S>
 class Sim3 {
  public:
+  // @{
+  // The scalar, the sizes and the Eigen types of the group, its tangent space and its matrices.
   using Scalar = S;
   static constexpr int kDoF = 7;
   static constexpr int kMatrixDim = 4;
@@ -33,14 +37,19 @@ class Sim3 {
   using Transformation = Matrix4;
   using AdjointMatrix = Matrix7;
   using Quaternion = Eigen::Quaternion<S>;
+  // @}
 
   Sim3() : scale_(1), translation_(Vector3::Zero()) {}
+  // @{
+  // A similarity from its scale, rotation (SO3, unit quaternion or rotation matrix) and
+  // translation.
   Sim3(S scale, const SO3<S>& rotation, const Vector3& translation)
       : scale_(scale), so3_(rotation), translation_(translation) {}
   Sim3(S scale, const Quaternion& rotation, const Vector3& translation)
       : scale_(scale), so3_(rotation), translation_(translation) {}
   Sim3(S scale, const Matrix3& rotation, const Vector3& translation)
       : scale_(scale), so3_(rotation), translation_(translation) {}
+  // @}
   // A rigid motion as a similarity of scale 1.
   explicit Sim3(const SE3<S>& pose)
       : scale_(1), so3_(pose.so3()), translation_(pose.translation()) {}
@@ -57,6 +66,7 @@ class Sim3 {
     return Sim3(s, Matrix3(sR / s), Vector3(m.template block<3, 1>(0, 3).template cast<S>()));
   }
 
+  // The similarity of a tangent vector (υ, ω, σ).
   static Sim3 exp(const Tangent& xi) {
     using std::exp;
     const S sigma = xi[6];
@@ -65,6 +75,7 @@ class Sim3 {
                 scaledRotationIntegral(sigma, omega) * xi.template head<3>());
   }
 
+  // The tangent vector of this similarity.
   Tangent log() const {
     using std::log;
     Tangent xi;
@@ -85,6 +96,7 @@ class Sim3 {
     m.template block<3, 1>(0, 3) = xi.template head<3>();
     return m;
   }
+  // The tangent vector of a 4×4 Lie-algebra matrix.
   static Tangent vee(const Matrix4& m) {
     Tangent xi;
     xi.template head<3>() = m.template block<3, 1>(0, 3);
@@ -105,24 +117,31 @@ class Sim3 {
     return a;
   }
 
+  // The inverse similarity.
   Sim3 inverse() const {
     const SO3<S> inv = so3_.inverse();
     const S invScale = S(1) / scale_;
     return Sim3(invScale, inv, -invScale * (inv * translation_));
   }
 
+  // @{
+  // Composition: (this · other)(p) = this(other(p)).
   Sim3 operator*(const Sim3& other) const {
     return Sim3(scale_ * other.scale_, so3_ * other.so3_,
                 scale_ * (so3_ * other.translation_) + translation_);
   }
   Sim3& operator*=(const Sim3& other) { return *this = *this * other; }
+  // @}
+  // The similarity applied to a point: s·R·p + t.
   Point operator*(const Point& p) const { return scale_ * (so3_ * p) + translation_; }
 
+  // The 4×4 matrix [sR t; 0 1].
   Matrix4 matrix() const {
     Matrix4 m = Matrix4::Identity();
     m.template block<3, 4>(0, 0) = matrix3x4();
     return m;
   }
+  // The top 3×4 block [sR | t].
   Matrix3x4 matrix3x4() const {
     Matrix3x4 m;
     m.template block<3, 3>(0, 0) = scale_ * so3_.matrix();
@@ -142,6 +161,8 @@ class Sim3 {
     return a;
   }
 
+  // @{
+  // The scale, rotation and translation, read and set.
   S scale() const { return scale_; }
   void setScale(S scale) { scale_ = scale; }
   const SO3<S>& so3() const { return so3_; }
@@ -152,14 +173,22 @@ class Sim3 {
   Vector3& translation() { return translation_; }
   void setRotation(const SO3<S>& rotation) { so3_ = rotation; }
   void setTranslation(const Vector3& translation) { translation_ = translation; }
+  // @}
+  // Renormalises the rotation's quaternion after many compositions.
   void normalize() { so3_.normalize(); }
 
+  // @{
+  // The left Jacobian of exp and its inverse: exp(ξ + δ) ≈ exp(J_l(ξ)·δ)·exp(ξ).
   static Matrix7 leftJacobian(const Tangent& xi) { return lie_detail::phi1<S, 7>(ad(xi)); }
   static Matrix7 leftJacobianInverse(const Tangent& xi) {
     return leftJacobian(xi).partialPivLu().inverse();
   }
+  // @}
+  // @{
+  // The right Jacobian of exp and its inverse: exp(ξ + δ) ≈ exp(ξ)·exp(J_r(ξ)·δ).
   static Matrix7 rightJacobian(const Tangent& xi) { return leftJacobian(-xi); }
   static Matrix7 rightJacobianInverse(const Tangent& xi) { return leftJacobianInverse(-xi); }
+  // @}
 
   // d(exp(δ)·q)/dδ at δ = 0 for the transformed point q = S·p: [I, −hat(q), q].
   static Eigen::Matrix<S, 3, 7> pointJacobianLeft(const Point& transformedPoint) {
@@ -170,6 +199,7 @@ class Sim3 {
     return j;
   }
 
+  // The same similarity in another scalar type.
   template <class T>
   Sim3<T> cast() const {
     return Sim3<T>(T(scale_), so3_.template cast<T>(), translation_.template cast<T>());
@@ -219,7 +249,10 @@ class Sim3 {
   Vector3 translation_;
 };
 
+// @{
+// Sim3 in double and float.
 using Sim3d = Sim3<double>;
 using Sim3f = Sim3<float>;
+// @}
 
 }  // namespace orbis

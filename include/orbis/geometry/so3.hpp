@@ -16,9 +16,12 @@
 
 namespace orbis {
 
+// A 3-D rotation, held as a unit quaternion (Sophus' conventions).
 template <class S>
 class SO3 {
  public:
+  // @{
+  // The scalar, the sizes and the Eigen types of the group, its tangent space and its matrices.
   using Scalar = S;
   static constexpr int kDoF = 3;
   static constexpr int kMatrixDim = 3;
@@ -29,14 +32,18 @@ class SO3 {
   using Transformation = Matrix3;
   using AdjointMatrix = Matrix3;
   using Quaternion = Eigen::Quaternion<S>;
+  // @}
 
   SO3() : q_(Quaternion::Identity()) {}
+  // The rotation of a quaternion (normalised here).
   explicit SO3(const Quaternion& q) : q_(q) { normalize(); }
   // Any 3x3 close to a rotation; the result is the rotation of its (normalised) quaternion.
   explicit SO3(const Matrix3& rotation) : q_(rotation) { normalize(); }
 
+  // The rotation of a rotation matrix.
   static SO3 fromMatrix(const Matrix3& rotation) { return SO3(rotation); }
 
+  // The rotation of a rotation vector ω (angle |ω| about ω).
   static SO3 exp(const Tangent& omega) {
     using std::cos;
     using std::sin;
@@ -58,6 +65,7 @@ class SO3 {
     return r;
   }
 
+  // The rotation vector of this rotation.
   Tangent log() const {
     using std::abs;
     using std::atan2;
@@ -80,11 +88,17 @@ class SO3 {
     return angleOverN * q_.vec();
   }
 
+  // @{
+  // Between rotation vectors and skew-symmetric matrices.
   static Matrix3 hat(const Tangent& omega) { return lie_detail::skew<S>(omega); }
   static Tangent vee(const Matrix3& m) { return Tangent(m(2, 1), m(0, 2), m(1, 0)); }
+  // @}
 
+  // The inverse rotation.
   SO3 inverse() const { return fromUnitQuaternion(q_.conjugate()); }
 
+  // @{
+  // Composition: (this · other)(p) = this(other(p)).
   SO3 operator*(const SO3& other) const {
     using std::abs;
     using std::sqrt;
@@ -94,17 +108,23 @@ class SO3 {
     return fromUnitQuaternion(q);
   }
   SO3& operator*=(const SO3& other) { return *this = *this * other; }
+  // @}
 
+  // The rotation applied to a point.
   Point operator*(const Point& p) const { return q_ * p; }
 
+  // @{
+  // The rotation matrix and the unit quaternion.
   Matrix3 matrix() const { return q_.toRotationMatrix(); }
   const Quaternion& unitQuaternion() const { return q_; }
+  // @}
   // The four quaternion coefficients (x, y, z, w), e.g. for an optimiser's parameter block.
   const S* data() const { return q_.coeffs().data(); }
 
   // Rotations act on their own tangent vectors by rotation: R·exp(φ)·R⁻¹ = exp(R·φ).
   Matrix3 Adj() const { return matrix(); }
 
+  // Renormalises the quaternion after many compositions.
   void normalize() { q_.normalize(); }
 
   // exp(φ + δ) ≈ exp(J_l(φ)·δ)·exp(φ).  J_l = I + (1−cosθ)/θ²·Φ + (θ−sinθ)/θ³·Φ².
@@ -145,14 +165,18 @@ class SO3 {
     return Matrix3::Identity() - S(0.5) * Phi + c * (Phi * Phi);
   }
 
+  // @{
+  // The right Jacobian of exp and its inverse: exp(φ + δ) ≈ exp(φ)·exp(J_r(φ)·δ).
   static Matrix3 rightJacobian(const Tangent& omega) { return leftJacobian(-omega); }
   static Matrix3 rightJacobianInverse(const Tangent& omega) { return leftJacobianInverse(-omega); }
+  // @}
 
   // d(exp(δ)·q)/dδ at δ = 0, where q = R·p is the rotated point.
   static Eigen::Matrix<S, 3, 3> pointJacobianLeft(const Point& rotatedPoint) {
     return -hat(rotatedPoint);
   }
 
+  // The same rotation in another scalar type.
   template <class T>
   SO3<T> cast() const {
     return SO3<T>(q_.template cast<T>());
@@ -169,7 +193,10 @@ class SO3 {
   Quaternion q_;
 };
 
+// @{
+// SO3 in double and float.
 using SO3d = SO3<double>;
 using SO3f = SO3<float>;
+// @}
 
 }  // namespace orbis

@@ -29,13 +29,23 @@
 
 namespace orbis {
 
+// A keypoint match between the two views of an initialisation, with each keypoint's level σ².
 struct TwoViewMatch {
+  // @{
+  // Undistorted pixels in view 1 and view 2.
   Eigen::Vector2d first, second;       // undistorted pixels in view 1 and view 2
+  // @}
+  // @{
+  // σ² of each keypoint's pyramid level (px²).
   double sigma2First = 1, sigma2Second = 1;  // σ² of each keypoint's pyramid level (px²)
+  // @}
 };
 
+// The two-view model a motion was recovered from: a homography (planar or low-parallax scene) or a
+// fundamental matrix.
 enum class TwoViewModel : std::uint8_t { Homography, Fundamental };
 
+// Why an initialisation attempt was refused (None: accepted).
 enum class TwoViewRefusal : std::uint8_t {
   None,                // accepted
   TooFewMatches,       // fewer than a minimal set (8), or fewer than minTriangulated
@@ -46,9 +56,13 @@ enum class TwoViewRefusal : std::uint8_t {
   Ambiguous,           // a second motion hypothesis explains nearly as many points
 };
 
+// @{
+// The model's or refusal's name, as reports print it.
 std::string_view toString(TwoViewModel model);
 std::string_view toString(TwoViewRefusal refusal);
+// @}
 
+// Thresholds of the two-view initialiser (ORB-SLAM's unless noted).
 struct TwoViewOptions {
   int ransacIterations = 200;       // ORB-SLAM's; each draws one 8-point set used by H and F
   double homographyRatioThreshold = 0.45;  // choose H when R_H exceeds this
@@ -58,7 +72,9 @@ struct TwoViewOptions {
   // ties and its plane ambiguity refuses frame after frame (rendered 320x240 loops: 16-73
   // frames). 0 turns the fallback off (the paper's rule alone).
   double fundamentalFallbackRatio = 0.5;
+  // The best motion must see its points under at least this parallax (degrees).
   double minParallaxDeg = 1.0;
+  // Points the best motion must triangulate.
   int minTriangulated = 50;
   double minGoodFractionOfInliers = 0.9;  // the winner triangulates at least this share
   double maxSecondBestRatio = 0.75;       // the runner-up must stay below this × the winner
@@ -67,21 +83,27 @@ struct TwoViewOptions {
   bool parallelModels = true;  // F's RANSAC on a second thread (same result either way)
 };
 
+// The outcome of an initialisation attempt: the motion and points when accepted, why not otherwise.
 struct TwoViewResult {
+  // Why refused (None: accepted).
   TwoViewRefusal refusal = TwoViewRefusal::TooFewMatches;
+  // The model the motion came from.
   TwoViewModel model = TwoViewModel::Fundamental;
   double homographyRatio = 0;  // R_H = S_H / (S_H + S_F)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // R: frame 1 -> frame 2
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();   // t, unit norm when accepted
+  // @{
   // Per match when accepted, empty when refused: the point in frame 1 (meaningful where
   // triangulated) and whether it passed every check under enough parallax to trust its depth.
   std::vector<Eigen::Vector3d> points;
   std::vector<bool> triangulated;
+  // @}
   int inliers = 0;        // matches inside the chosen model's χ² gates
   int goodPoints = 0;     // the best motion's points passing cheirality and reprojection
   int secondBestGood = 0; // the runner-up motion's
   double parallaxDeg = 0; // the best motion's parallax (ORB-SLAM's: the 51st largest angle)
 
+  // Whether the attempt was accepted.
   bool accepted() const { return refusal == TwoViewRefusal::None; }
 };
 

@@ -14,7 +14,10 @@
 
 namespace orbis {
 
+// Reads a problem in the BAL (Bundle Adjustment in the Large) text format; throws orbis::Error
+// naming the file and line.
 BalProblem readBal(const std::filesystem::path& file);
+// Writes a problem in the BAL text format.
 void writeBal(const std::filesystem::path& file, const BalProblem& problem);
 
 }  // namespace orbis

@@ -21,21 +21,28 @@
 
 namespace orbis {
 
+// How a dense cloud is sampled from depth maps.
 struct DenseCloudOptions {
   double voxelSize = 0.01;  // metres
   double maxDepth = 4.0;    // metres: Kinect-type depth degrades quickly beyond
   int pixelStride = 2;      // every n-th pixel in both directions
 };
 
+// Back-projects depth maps into a coloured point cloud, one point per occupied voxel (orbis run
+// --dense).
 class DenseCloudBuilder {
  public:
+  // camera: the depth maps' camera; depthScale: raw depth per metre.
   DenseCloudBuilder(const PinholeCamera<double>& camera, double depthScale, DenseCloudOptions options = {});
 
   // colour: 8-bit grey or BGR of the same size as depth, or empty.
   void addView(const SE3d& cameraToWorld, const cv::Mat& depth, const cv::Mat& colour);
 
+  // Voxels occupied so far.
   std::size_t voxelCount() const { return voxels_.size(); }
+  // The cloud: one point and colour per voxel.
   void points(std::vector<Eigen::Vector3f>& xyz, std::vector<std::array<std::uint8_t, 3>>& rgb) const;
+  // Writes the cloud as binary PLY.
   void writePly(const std::filesystem::path& file) const;
 
  private:

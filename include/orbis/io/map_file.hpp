@@ -11,6 +11,9 @@
 //           spanning-tree parent, loop edges, covisibility edges with weights;
 //   map points (good ones, by id): position, reference keyframe, creating frame, descriptor,
 //           visible/found counters, observations (keyframe, keypoint index);
+//   atlas (version 3): the number of maps, per map its start frame and the map it was merged
+//           into (-1: none), the active map, then per keyframe (in keyframe order) its map and
+//           flags (1: its map's root, never culled; 2: the gauge BA keeps fixed);
 //   trailer: bow::checksum64 of everything before it.
 // Ids in the file are those of the saving map; loading creates keyframes and points afresh in
 // the same order (ids are renumbered densely, order preserved). The mean viewing direction and
@@ -22,7 +25,8 @@
 // held by two points, word or node ids beyond the caller's vocabulary). It throws orbis::Error
 // naming the file and the defect — nothing is added to the map on failure. Version 1 files (no
 // scale field) still load: their scale follows from the sensor, since monocular was the only
-// sensor without metric scale when version 2 added the field.
+// sensor without metric scale when version 2 added the field. Version 1 and 2 files (no atlas
+// section) load as one map, its first keyframe the root.
 #pragma once
 
 #include <cstdint>
@@ -35,20 +39,30 @@
 
 namespace orbis {
 
-inline constexpr std::uint32_t kMapFileVersion = 2;
+// The map file format's version, written in the header.
+inline constexpr std::uint32_t kMapFileVersion = 3;
 
+// What a map file's header records.
 struct MapFileInfo {
+  // The sensor that made the map.
   SensorKind sensor = SensorKind::Stereo;
   MapIntrinsics intrinsics;  // of the system that saved it (fx, fy, cx, cy, bf are checked)
+  // Checksum of the vocabulary the map's bag-of-words vectors refer to.
   std::uint64_t vocabularyChecksum = 0;
+  // @{
+  // Keyframes and map points in the file.
   std::uint64_t keyFrames = 0, mapPoints = 0;
+  // @}
+  // @{
   // Not in the file: when non-zero, what readMapFile's caller's vocabulary holds. Every word and
   // node id of the keyframes' BoW and feature vectors must be below them (a corrupt id would
   // size the keyframe database's inverted index, or index the vocabulary, far out of bounds).
   std::uint64_t vocabularyWords = 0, vocabularyNodes = 0;
+  // @}
   // False: the map's unit is arbitrary (a monocular map; Sensor::kMetricScale). Read back from
   // the file and checked against the caller's.
   bool metricScale = true;
+  std::uint32_t version = 0;  // the file's format version (read back; writing uses kMapFileVersion)
 };
 
 // Identifies the vocabulary a map's BoW vectors belong to (checksum of its whole file block).

@@ -18,14 +18,21 @@
 
 namespace orbis {
 
+// What the top-view overview picture draws.
 struct OverviewScene {
+  // Drawn at the top.
   std::string title;
+  // Map points, drawn as dots.
   std::vector<Eigen::Vector3f> mapPoints;
+  // Every tracked frame's pose.
   Trajectory estimate;
+  // The keyframes, drawn as small frusta.
   Trajectory keyFrames;
   Trajectory groundTruth;  // may be empty
 };
 
+// Writes the overview (PNG) of size × size pixels, viewed from above the two axes of largest
+// extent.
 void writeOverview(const std::filesystem::path& file, const OverviewScene& scene, int size = 900);
 
 }  // namespace orbis

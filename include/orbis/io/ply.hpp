@@ -14,9 +14,12 @@
 
 namespace orbis {
 
+// Writes points (and per-point colours, when given) as binary PLY.
 void writePly(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& points,
               const std::vector<std::array<std::uint8_t, 3>>& colours = {});
 
+// Reads the vertices of a PLY file (ASCII or binary little-endian); throws orbis::Error naming the
+// file.
 std::vector<Eigen::Vector3f> readPly(const std::filesystem::path& path);
 
 }  // namespace orbis

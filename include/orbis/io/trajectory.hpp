@@ -30,16 +30,20 @@
 
 namespace orbis {
 
+// A pose with its timestamp.
 struct StampedPose {
   double t = 0.0;  // seconds
   SE3d pose;       // camera-to-world
 };
+// A trajectory: poses in time order.
 using Trajectory = std::vector<StampedPose>;
 
+// The trajectory file formats: TUM (t x y z qx qy qz qw), KITTI (3×4 row-major) and EuRoC csv.
 enum class TrajectoryFormat { Tum, Kitti, Euroc };
 
 // "tum", "kitti" or "euroc"; throws orbis::Error(source) for anything else.
 TrajectoryFormat parseTrajectoryFormat(std::string_view name, const std::string& source = "format");
+// "tum", "kitti" or "euroc".
 std::string_view toString(TrajectoryFormat format);
 
 // Guesses from the first data row: comma-separated (or in a .csv) with integer nanoseconds first
@@ -53,6 +57,7 @@ Trajectory readTrajectory(const std::filesystem::path& file, TrajectoryFormat fo
 // Reads a KITTI times.txt-style file: one timestamp per line, strictly increasing.
 std::vector<double> readTimestamps(const std::filesystem::path& file);
 
+// Writes a trajectory in the given format.
 void writeTrajectory(const std::filesystem::path& file, const Trajectory& trajectory,
                      TrajectoryFormat format);
 
@@ -72,9 +77,16 @@ Trajectory posesCovering(const Trajectory& trajectory, const Trajectory& span, d
 // sorted by time (stable, so of equal timestamps the first in the file comes first) with every
 // row whose timestamp equals the one kept before it dropped.
 struct TimeOrder {
+  // The rows to keep, in time order.
   std::vector<std::size_t> keep;
+  // @{
+  // Rows dropped for a repeated timestamp, and rows earlier than their predecessor.
   std::size_t repeated = 0, outOfOrder = 0;                  // rows dropped / rows earlier than their predecessor
+  // @}
+  // @{
+  // The first line of each kind (1-based; 0 when none).
   std::size_t firstRepeatedLine = 0, firstOutOfOrderLine = 0;  // 1-based lines, 0 when none
+  // @}
   // One warning per kind of repair, naming the file, the count and the first line.
   std::vector<std::string> warnings(const std::filesystem::path& file) const;
 };
@@ -85,13 +97,16 @@ TimeOrder putInTimeOrder(const std::vector<double>& times, const std::vector<std
 // One data row of a text table: its 1-based line number and its fields (split on whitespace
 // and commas; blank lines and lines starting with '#' are skipped). The views die with the row.
 struct TextRow {
+  // The row's line number, 1-based.
   std::size_t line = 0;
+  // The row's fields.
   std::span<const std::string_view> fields;
 };
 // Calls visit for every data row of file; throws orbis::Error when the file cannot be opened.
 void forEachTextRow(const std::filesystem::path& file, const std::function<void(const TextRow&)>& visit);
 // Parses a field as a finite double / an integer; throws orbis::Error naming file and line.
 double parseDouble(std::string_view field, const std::filesystem::path& file, std::size_t line);
+// An integer field; throws orbis::Error naming file and line.
 long long parseInteger(std::string_view field, const std::filesystem::path& file, std::size_t line);
 
 }  // namespace orbis

@@ -22,6 +22,12 @@
 // mode; its result is merged under the map lock with local mapping paused: optimised keyframes
 // take their new poses, keyframes created meanwhile follow their spanning-tree parent, points
 // created meanwhile follow their reference keyframe.
+// The atlas (issue 32): candidates in another map of the atlas than the keyframe's are merge
+// candidates, kept by the same consistency rule in their own groups and verified by the same
+// transform; a merge (loop_merge_impl.hpp) moves the smaller map into the other's frame,
+// relabels it, then fuses, optimises the essential graph, runs a welding BA around the seam and
+// full BA, as a loop does. Loops and merges stay within one map; full BA and the essential graph
+// cover the keyframe's map only.
 // Threaded: a worker consumes the queue. Deterministic: nothing runs until runUntilIdle(), which
 // does everything (full BA included) on the caller's thread, so results are bit-identical.
 // Each step holds Map::mutex(); the essential graph and full BA solve on copies outside it.
@@ -53,7 +59,9 @@
 
 namespace orbis {
 
+// Loop closing's thresholds (ORB-SLAM2's unless noted).
 struct LoopCloserOptions {
+  // Runs on its own thread (false: inline, deterministic mode).
   bool threaded = true;
   std::uint32_t seed = 0;               // RANSAC generator
   int consistencyThreshold = 3;         // consecutive keyframes a candidate group must persist
@@ -62,16 +70,27 @@ struct LoopCloserOptions {
   int minPoseInliers = 20;              // after guided matching and refinement
   int minLoopMatches = 40;              // after projecting the loop neighbourhood
   int essentialGraphMinWeight = 100;    // covisibility edges kept in the essential graph
+  // @{
+  // Whether a full BA runs after a loop correction, and its iterations.
   bool fullBundleAdjustment = true;
   int fullBundleAdjustmentIterations = 10;
+  // @}
+  // @{
+  // Merging maps of the atlas: on, and the active map's keyframes a merge needs.
+  bool mergeMaps = true;
+  int mergeMinKeyFrames = 5;
+  // @}
   // Receives "loop closed: ..." lines; null prints them to stderr.
   std::function<void(const std::string&)> log;
 };
 
 
+// Loop closing (§III-D, §V): detection by bag of words, a verified Sim(3) (SE(3) for metric
+// sensors), loop fusion, essential-graph optimisation, then a full BA on a worker.
 template <SensorConfiguration Sensor>
 class LoopCloser {
  public:
+  // The sensor's camera model.
   using Camera = typename Sensor::Camera;
   // The loop's correction of a pose: rigid for metric sensors, a similarity for monocular.
   using Correction = std::conditional_t<Sensor::kMetricScale, SE3d, Sim3d>;
@@ -89,9 +108,14 @@ class LoopCloser {
   void runUntilIdle();
   // Block until the queue is empty, the worker idle and no full BA is running.
   void waitUntilIdle();
+  // Finishes queued work and joins the threads.
   void shutdown();
 
+  // @{
+  // The loops closed so far, in order.
   std::vector<LoopClosureEvent> closures() const;
+  std::vector<MapMergeEvent> merges() const;
+  // @}
 
  private:
   struct ConsistentGroup {
@@ -110,7 +134,10 @@ class LoopCloser {
   bool processOne();
   // Holding the map mutex:
   void dropBadKeyFrames();
-  std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf);
+  // Loop candidates (same map), and in mergeCandidates those of other maps of the atlas.
+  std::vector<KeyFrame*> detectConsistentCandidates(KeyFrame* kf, std::vector<KeyFrame*>& mergeCandidates);
+  // ORB-SLAM's consistency check of candidates against the previous keyframes' groups.
+  std::vector<KeyFrame*> keepConsistent(const std::vector<KeyFrame*>& candidates, std::vector<ConsistentGroup>& groups);
   bool computeRelativePose(KeyFrame* kf, const std::vector<KeyFrame*>& candidates, LoopCandidate& out);
   // One candidate's transform from its bag-of-words matches (ORB-SLAM's ComputeSim3): RANSAC,
   // guided matching both ways through its result, two-way refinement; SE(3) or Sim(3) by the
@@ -118,13 +145,27 @@ class LoopCloser {
   bool loopTransform(KeyFrame* kf, KeyFrame* candidate, const std::vector<MapPoint*>& matches, LoopCandidate& out);
   // Takes the map mutex itself (pauses local mapping first):
   void correctLoop(KeyFrame* kf, LoopCandidate& loop);
+  // The map-merge counterpart (loop_merge_impl.hpp).
+  void mergeMaps(KeyFrame* kf, LoopCandidate& loop);
+  // Holding the map mutex: moves map `moved` into the frame of `kept` (x_kept = S·x_moved).
+  void moveMap(std::uint32_t moved, const Correction& S);
+
   using PoseMap = std::map<KeyFrame*, SE3d, ById>;
   using LinkMap = std::map<KeyFrame*, std::set<KeyFrame*, ById>, ById>;
   using CorrectionMap = std::map<KeyFrame*, Correction, ById>;
   using PointCorrectors = std::map<MapPoint*, KeyFrame*, ById>;
+  struct Fusion {
+    PoseMap nonCorrected;
+    CorrectionMap corrected;
+    LinkMap loopLinks;
+    PointCorrectors correctedBy;
+  };
+  // The loop's correction of the current keyframe's neighbourhood, fusion and links (the part
+  // correctLoop and mergeMaps share); takes the lock. Returns the points fused.
+  int fuseAcrossLoop(KeyFrame* kf, LoopCandidate& loop, Fusion& fusion);
   void optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, const PoseMap& nonCorrected, const CorrectionMap& corrected,
                               const LinkMap& loopLinks, const PointCorrectors& correctedBy);
-  void startFullBundleAdjustment();
+  void startFullBundleAdjustment(std::uint32_t mapId);
   void runFullBundleAdjustment();
   void stopFullBundleAdjustment();
   void pauseMapping();
@@ -142,15 +183,18 @@ class LoopCloser {
 
   std::vector<KeyFrame*> indexed_;  // keyframes in the database (loop thread only)
   std::vector<ConsistentGroup> consistentGroups_;
+  std::vector<ConsistentGroup> mergeGroups_;
   KeyFrameId lastLoopKeyFrame_ = 0;
   bool anyLoop_ = false;
 
   mutable std::mutex eventsMutex_;
   std::vector<LoopClosureEvent> events_;
+  std::vector<MapMergeEvent> merges_;
 
   std::thread fullBaThread_;
   std::atomic<bool> abortFullBa_{false};
   std::atomic<bool> fullBaRunning_{false};
+  std::uint32_t fullBaMap_ = 0;  // the map the running full BA optimises
 
   QueueWorker<KeyFrame*> worker_;  // last: its thread stops before the state it serves goes
 };
@@ -159,6 +203,7 @@ class LoopCloser {
 
 #include "orbis/loop/loop_closer_impl.hpp"
 #include "orbis/loop/loop_correction_impl.hpp"
+#include "orbis/loop/loop_merge_impl.hpp"
 
 namespace orbis {
 extern template class LoopCloser<Stereo>;

@@ -62,6 +62,12 @@ std::vector<LoopClosureEvent> LoopCloser<Sensor>::closures() const {
 }
 
 template <SensorConfiguration Sensor>
+std::vector<MapMergeEvent> LoopCloser<Sensor>::merges() const {
+  std::lock_guard lock(eventsMutex_);
+  return merges_;
+}
+
+template <SensorConfiguration Sensor>
 void LoopCloser<Sensor>::report(const std::string& line) const {
   if (options_.log) {
     options_.log(line);
@@ -76,25 +82,33 @@ bool LoopCloser<Sensor>::processOne() {
   if (!next) return false;
   KeyFrame* kf = *next;
   LoopCandidate loop;
-  bool found = false;
+  bool found = false, merge = false;
   {
     ScopedStage stage(timer_, "loop: detection");
     std::lock_guard lock(map_.mutex());
     dropBadKeyFrames();
     if (kf->isBad()) return true;
     kf->setProtected(true);  // local mapping must not cull it while we look at it
-    const std::vector<KeyFrame*> candidates = detectConsistentCandidates(kf);
+    std::vector<KeyFrame*> mergeCandidates;
+    const std::vector<KeyFrame*> candidates = detectConsistentCandidates(kf, mergeCandidates);
     database_.add(kf->id, kf->bowVector());
     indexed_.push_back(kf);
-    if (!candidates.empty()) {
-      for (KeyFrame* c : candidates) c->setProtected(true);
-      found = computeRelativePose(kf, candidates, loop);
-      for (KeyFrame* c : candidates)
+    // A loop first; a place of another map only when no loop closes with this keyframe.
+    const std::vector<KeyFrame*>* lists[] = {&candidates, &mergeCandidates};
+    for (const std::vector<KeyFrame*>* list : lists) {
+      if (found || list->empty()) continue;
+      for (KeyFrame* c : *list) c->setProtected(true);
+      found = computeRelativePose(kf, *list, loop);
+      merge = found && list == &mergeCandidates;
+      for (KeyFrame* c : *list)
         if (c != loop.loopKeyFrame || !found) c->setProtected(false);
     }
     if (!found) kf->setProtected(false);
   }
-  if (found) {
+  if (found && merge) {
+    ScopedStage stage(timer_, "loop: map merge");
+    mergeMaps(kf, loop);
+  } else if (found) {
     ScopedStage stage(timer_, "loop: correction");
     correctLoop(kf, loop);
   }
@@ -111,27 +125,43 @@ void LoopCloser<Sensor>::dropBadKeyFrames() {
 }
 
 template <SensorConfiguration Sensor>
-std::vector<KeyFrame*> LoopCloser<Sensor>::detectConsistentCandidates(KeyFrame* kf) {
-  // Too soon after a loop, or too small a map: nothing to close.
-  if ((anyLoop_ && kf->id < lastLoopKeyFrame_ + static_cast<KeyFrameId>(options_.keyFramesAfterLoop)) ||
-      map_.keyFrameCount() <= static_cast<std::size_t>(options_.keyFramesAfterLoop)) {
-    consistentGroups_.clear();
-    return {};
-  }
+std::vector<KeyFrame*> LoopCloser<Sensor>::detectConsistentCandidates(KeyFrame* kf,
+                                                                      std::vector<KeyFrame*>& mergeCandidates) {
+  // Too soon after a loop, or too small a map: nothing to close. A merge needs the keyframe's map
+  // to be the active one (a keyframe queued before tracking moved to another map does not) and
+  // a few keyframes, with another map in the atlas.
+  const bool tooSoon = anyLoop_ && kf->id < lastLoopKeyFrame_ + static_cast<KeyFrameId>(options_.keyFramesAfterLoop);
+  const std::size_t ownKeyFrames = map_.keyFrameCount(kf->mapId());
+  const bool loopsPossible = !tooSoon && ownKeyFrames > static_cast<std::size_t>(options_.keyFramesAfterLoop);
+  const bool mergesPossible = !tooSoon && options_.mergeMaps && kf->mapId() == map_.activeMapId() &&
+                              ownKeyFrames >= static_cast<std::size_t>(options_.mergeMinKeyFrames) &&
+                              map_.keyFrameCount() > ownKeyFrames;
+  if (!loopsPossible) consistentGroups_.clear();
+  if (!mergesPossible) mergeGroups_.clear();
+  if (!loopsPossible && !mergesPossible) return {};
   const MapCovisibility graph(map_);
-  std::vector<KeyFrame*> candidates;
+  std::vector<KeyFrame*> sameMap, otherMaps;
   for (const bow::PlaceCandidate& c : database_.detectLoopCandidates(kf->id, kf->bowVector(), graph)) {
     KeyFrame* k = map_.keyFrame(c.keyframe);
-    if (k && !k->isBad()) candidates.push_back(k);
+    if (!k || k->isBad()) continue;
+    (k->mapId() == kf->mapId() ? sameMap : otherMaps).push_back(k);
   }
+  if (mergesPossible) mergeCandidates = keepConsistent(otherMaps, mergeGroups_);
+  if (!loopsPossible) return {};
+  return keepConsistent(sameMap, consistentGroups_);
+}
+
+template <SensorConfiguration Sensor>
+std::vector<KeyFrame*> LoopCloser<Sensor>::keepConsistent(const std::vector<KeyFrame*>& candidates,
+                                                          std::vector<ConsistentGroup>& groups) {
   if (candidates.empty()) {
-    consistentGroups_.clear();
+    groups.clear();
     return {};
   }
   // ORB-SLAM's consistency check: a candidate's group (itself and its covisible keyframes) must
   // share a keyframe with a group that was consistent for the previous keyframes.
   std::vector<ConsistentGroup> current;
-  std::vector<char> groupContinued(consistentGroups_.size(), 0);
+  std::vector<char> groupContinued(groups.size(), 0);
   std::vector<KeyFrame*> enough;
   for (KeyFrame* candidate : candidates) {
     ConsistentGroup group;
@@ -139,13 +169,13 @@ std::vector<KeyFrame*> LoopCloser<Sensor>::detectConsistentCandidates(KeyFrame* 
     for (KeyFrame* n : candidate->covisibles())
       if (!n->isBad()) group.members.insert(n->id);
     bool consistentWithSome = false, added = false;
-    for (std::size_t g = 0; g < consistentGroups_.size(); ++g) {
-      const auto& previous = consistentGroups_[g].members;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const auto& previous = groups[g].members;
       const bool shares = std::any_of(group.members.begin(), group.members.end(),
                                       [&](KeyFrameId id) { return previous.count(id) != 0; });
       if (!shares) continue;
       consistentWithSome = true;
-      const int consistency = consistentGroups_[g].consistency + 1;
+      const int consistency = groups[g].consistency + 1;
       if (!groupContinued[g]) {
         current.push_back({group.members, consistency});
         groupContinued[g] = 1;
@@ -157,7 +187,7 @@ std::vector<KeyFrame*> LoopCloser<Sensor>::detectConsistentCandidates(KeyFrame* 
     }
     if (!consistentWithSome) current.push_back({group.members, 0});
   }
-  consistentGroups_ = std::move(current);
+  groups = std::move(current);
   return enough;
 }
 

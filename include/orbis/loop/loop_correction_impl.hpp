@@ -42,75 +42,81 @@ void LoopCloser<Sensor>::resumeMapping() {
 }
 
 template <SensorConfiguration Sensor>
+int LoopCloser<Sensor>::fuseAcrossLoop(KeyFrame* kf, LoopCandidate& loop, Fusion& fusion) {
+  auto& [nonCorrected, corrected, loopLinks, correctedBy] = fusion;
+  int fused = 0;
+  std::lock_guard lock(map_.mutex());
+  kf->updateConnections();
+  // The current keyframe and its neighbours move rigidly with the loop transform (metric), or
+  // by the loop's similarity (monocular): S_iw' = T_ic·S_cw', so their scale drift goes too.
+  std::vector<KeyFrame*> connected{kf};
+  for (KeyFrame* n : kf->covisibles())
+    if (!n->isBad()) connected.push_back(n);
+  const SE3d Twc = kf->Twc();
+  for (KeyFrame* k : connected) {
+    nonCorrected[k] = k->Tcw();
+    corrected[k] = k == kf ? loop.correctedScw : Correction(k->Tcw() * Twc) * loop.correctedScw;
+  }
+  for (const auto& [k, Scw] : corrected) {
+    const Correction Swc_corrected = Scw.inverse();
+    const SE3d& Tcw_old = nonCorrected[k];
+    // A point leaves its camera at the old pose and re-enters the world by the correction.
+    for (MapPoint* p : k->goodPoints()) {
+      if (!correctedBy.emplace(p, k).second) continue;
+      p->setPosition(Swc_corrected * (Tcw_old * p->position()));
+    }
+    k->setPose(loop_detail::asPose(Scw));
+  }
+  for (const auto& [p, k] : correctedBy) p->updateNormalAndDepth();
+  for (KeyFrame* k : connected) k->updateConnections();
+
+  // Loop fusion: the current keyframe's matches become the loop side's points.
+  for (std::size_t i = 0; i < loop.matches.size(); ++i) {
+    MapPoint* loopPoint = loop_detail::followReplacements(loop.matches[i]);
+    if (!loopPoint) continue;
+    MapPoint* own = kf->point(i);
+    if (own && !own->isBad()) {
+      if (own != loopPoint) {
+        own->replaceWith(loopPoint);
+        ++fused;
+      }
+    } else if (!loopPoint->isObservedBy(kf)) {
+      kf->setPoint(i, loopPoint);
+      loopPoint->addObservation(kf, i);
+      loopPoint->computeDistinctiveDescriptor();
+    }
+  }
+  // Duplicates in the neighbourhood, now that both sides agree.
+  std::vector<MapPoint*> loopPoints;
+  for (MapPoint* p : loop.loopPoints)
+    if (MapPoint* q = loop_detail::followReplacements(p)) loopPoints.push_back(q);
+  for (KeyFrame* k : connected)
+    if (!k->isBad()) fused += matching::fuse(camera_, *k, loopPoints, 4.0f);
+
+  // Links the fusion created between the two sides of the loop.
+  for (KeyFrame* k : connected) {
+    if (k->isBad()) continue;
+    const std::vector<KeyFrame*> previous = k->covisibles();
+    k->updateConnections();
+    std::set<KeyFrame*, ById> links = k->connectedSet();
+    for (KeyFrame* n : previous) links.erase(n);
+    for (KeyFrame* n : connected) links.erase(n);
+    if (!links.empty()) loopLinks[k] = std::move(links);
+  }
+  loop.loopKeyFrame->addLoopEdge(kf);
+  kf->addLoopEdge(loop.loopKeyFrame);
+  return fused;
+}
+
+template <SensorConfiguration Sensor>
 void LoopCloser<Sensor>::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
   // A full BA still running would merge a map this correction has already moved.
   stopFullBundleAdjustment();
   pauseMapping();
   KeyFrame* loopKf = loop.loopKeyFrame;
-  PoseMap nonCorrected;
-  CorrectionMap corrected;
-  LinkMap loopLinks;
-  PointCorrectors correctedBy;
-  {
-    std::lock_guard lock(map_.mutex());
-    kf->updateConnections();
-    // The current keyframe and its neighbours move rigidly with the loop transform (metric), or
-    // by the loop's similarity (monocular): S_iw' = T_ic·S_cw', so their scale drift goes too.
-    std::vector<KeyFrame*> connected{kf};
-    for (KeyFrame* n : kf->covisibles())
-      if (!n->isBad()) connected.push_back(n);
-    const SE3d Twc = kf->Twc();
-    for (KeyFrame* k : connected) {
-      nonCorrected[k] = k->Tcw();
-      corrected[k] = k == kf ? loop.correctedScw : Correction(k->Tcw() * Twc) * loop.correctedScw;
-    }
-    for (const auto& [k, Scw] : corrected) {
-      const Correction Swc_corrected = Scw.inverse();
-      const SE3d& Tcw_old = nonCorrected[k];
-      // A point leaves its camera at the old pose and re-enters the world by the correction.
-      for (MapPoint* p : k->goodPoints()) {
-        if (!correctedBy.emplace(p, k).second) continue;
-        p->setPosition(Swc_corrected * (Tcw_old * p->position()));
-      }
-      k->setPose(loop_detail::asPose(Scw));
-    }
-    for (const auto& [p, k] : correctedBy) p->updateNormalAndDepth();
-    for (KeyFrame* k : connected) k->updateConnections();
-
-    // Loop fusion: the current keyframe's matches become the loop side's points.
-    for (std::size_t i = 0; i < loop.matches.size(); ++i) {
-      MapPoint* loopPoint = loop_detail::followReplacements(loop.matches[i]);
-      if (!loopPoint) continue;
-      MapPoint* own = kf->point(i);
-      if (own && !own->isBad()) {
-        if (own != loopPoint) own->replaceWith(loopPoint);
-      } else if (!loopPoint->isObservedBy(kf)) {
-        kf->setPoint(i, loopPoint);
-        loopPoint->addObservation(kf, i);
-        loopPoint->computeDistinctiveDescriptor();
-      }
-    }
-    // Duplicates in the neighbourhood, now that both sides agree.
-    std::vector<MapPoint*> loopPoints;
-    for (MapPoint* p : loop.loopPoints)
-      if (MapPoint* q = loop_detail::followReplacements(p)) loopPoints.push_back(q);
-    for (KeyFrame* k : connected)
-      if (!k->isBad()) matching::fuse(camera_, *k, loopPoints, 4.0f);
-
-    // Links the fusion created between the two sides of the loop.
-    for (KeyFrame* k : connected) {
-      if (k->isBad()) continue;
-      const std::vector<KeyFrame*> previous = k->covisibles();
-      k->updateConnections();
-      std::set<KeyFrame*, ById> links = k->connectedSet();
-      for (KeyFrame* n : previous) links.erase(n);
-      for (KeyFrame* n : connected) links.erase(n);
-      if (!links.empty()) loopLinks[k] = std::move(links);
-    }
-    loopKf->addLoopEdge(kf);
-    kf->addLoopEdge(loopKf);
-  }
-  optimiseEssentialGraph(kf, loopKf, nonCorrected, corrected, loopLinks, correctedBy);
+  Fusion fusion;
+  fuseAcrossLoop(kf, loop, fusion);
+  optimiseEssentialGraph(kf, loopKf, fusion.nonCorrected, fusion.corrected, fusion.loopLinks, fusion.correctedBy);
   anyLoop_ = true;
   lastLoopKeyFrame_ = kf->id;
   LoopClosureEvent event{kf->id, loopKf->id, kf->frameIndex, loop.matched};
@@ -129,7 +135,7 @@ void LoopCloser<Sensor>::correctLoop(KeyFrame* kf, LoopCandidate& loop) {
   }
   report(line);
   resumeMapping();
-  if (options_.fullBundleAdjustment) startFullBundleAdjustment();
+  if (options_.fullBundleAdjustment) startFullBundleAdjustment(kf->mapId());
 }
 
 template <SensorConfiguration Sensor>
@@ -143,7 +149,7 @@ void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, 
   std::vector<Edge> edges;
   {
     std::lock_guard lock(map_.mutex());
-    keyFrames = map_.keyFrames();
+    keyFrames = map_.keyFrames(kf->mapId());
     // A keyframe's pose after the loop moved it: its pose for a metric sensor; for monocular the
     // similarity the correction gave it (its pose alone has lost the scale), else its pose at
     // scale 1.
@@ -198,7 +204,8 @@ void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, 
   // Points move with the keyframe that last corrected them: the loop's corrector, else their
   // reference keyframe. Through the similarities for monocular: into that keyframe's camera at
   // the scale it had, back out at the scale the graph gave it.
-  for (MapPoint* p : map_.mapPoints()) {
+  const std::vector<MapPoint*> points = map_.mapPoints(kf->mapId());
+  for (MapPoint* p : points) {
     const auto c = correctedBy.find(p);
     const KeyFrame* ref = c != correctedBy.end() ? c->second : p->reference();
     const auto it = ref ? index.find(ref) : index.end();
@@ -208,7 +215,7 @@ void LoopCloser<Sensor>::optimiseEssentialGraph(KeyFrame* kf, KeyFrame* loopKf, 
   }
   for (std::size_t i = 0; i < keyFrames.size(); ++i)
     if (!keyFrames[i]->isBad()) keyFrames[i]->setPose(loop_detail::asPose(poses[i]));
-  for (MapPoint* p : map_.mapPoints()) p->updateNormalAndDepth();
+  for (MapPoint* p : points) p->updateNormalAndDepth();
 }
 
 template <SensorConfiguration Sensor>
@@ -220,8 +227,9 @@ void LoopCloser<Sensor>::stopFullBundleAdjustment() {
 }
 
 template <SensorConfiguration Sensor>
-void LoopCloser<Sensor>::startFullBundleAdjustment() {
+void LoopCloser<Sensor>::startFullBundleAdjustment(std::uint32_t mapId) {
   stopFullBundleAdjustment();
+  fullBaMap_ = mapId;
   fullBaRunning_ = true;
   if (!options_.threaded) {
     runFullBundleAdjustment();
@@ -239,7 +247,8 @@ void LoopCloser<Sensor>::runFullBundleAdjustment() {
   FullBundleAdjustmentResult result;
   {
     ScopedStage stage(timer_, "loop: full BA");
-    result = fullBundleAdjustment<typename Sensor::RobustKernel>(camera_, map_, options_.fullBundleAdjustmentIterations, &abortFullBa_);
+    result = fullBundleAdjustment<typename Sensor::RobustKernel>(camera_, map_, options_.fullBundleAdjustmentIterations,
+                                                                 &abortFullBa_, fullBaMap_);
   }
   if (result.aborted || abortFullBa_) return;
   pauseMapping();
@@ -248,12 +257,13 @@ void LoopCloser<Sensor>::runFullBundleAdjustment() {
     std::lock_guard lock(map_.mutex());
     // Keyframes: optimised ones take their new pose; the others (created meanwhile) follow their
     // spanning-tree parent, visited from the root down.
+    // Only the optimised map's: the other maps of the atlas are in frames of their own.
+    const std::vector<KeyFrame*> keyFrames = map_.keyFrames(fullBaMap_);
     PoseMap before;
-    for (KeyFrame* k : map_.keyFrames()) before[k] = k->Tcw();
+    for (KeyFrame* k : keyFrames) before[k] = k->Tcw();
     std::vector<KeyFrame*> stack;
-    if (KeyFrame* root = map_.origin(); root && !root->isBad()) stack.push_back(root);
-    for (KeyFrame* k : map_.keyFrames())
-      if (!k->parent() && k != map_.origin()) stack.push_back(k);  // a second root, if any
+    for (KeyFrame* k : keyFrames)
+      if (!k->parent()) stack.push_back(k);  // the roots, in id order (merged maps have several)
     std::set<KeyFrame*, ById> visited;
     while (!stack.empty()) {
       KeyFrame* k = stack.back();
@@ -269,7 +279,7 @@ void LoopCloser<Sensor>::runFullBundleAdjustment() {
         if (!child->isBad()) stack.push_back(child);
     }
     // Points: optimised ones take their new position, the others follow their reference.
-    for (MapPoint* p : map_.mapPoints()) {
+    for (MapPoint* p : map_.mapPoints(fullBaMap_)) {
       if (const auto it = result.pointPositions.find(p->id); it != result.pointPositions.end()) {
         p->setPosition(it->second);
       } else if (KeyFrame* ref = p->reference(); ref && before.count(ref)) {

@@ -27,33 +27,58 @@
 
 namespace orbis::loop {
 
+// A map point matched between two keyframes: its position in each camera, its keypoints and their
+// weights.
 struct PointPair {
+  // @{
+  // The point in camera 1 and in camera 2.
   Eigen::Vector3d p1, p2;      // the point in camera 1 and in camera 2
+  // @}
+  // @{
+  // Its keypoints (undistorted pixels).
   Eigen::Vector2d obs1, obs2;  // its keypoints (undistorted pixels)
+  // @}
+  // @{
+  // 1/σ² of each keypoint.
   double information1 = 1, information2 = 1;
+  // @}
 };
 
 // A pair's χ² (information·‖π(T12·p2) − obs1‖², and the same for π(T12⁻¹·p1) against obs2);
 // not valid when the point falls behind either camera.
 struct PairChi2 {
+  // @{
+  // The χ² in image 1 and image 2.
   double chi2First = 0, chi2Second = 0;
+  // @}
+  // False when the point falls behind either camera.
   bool valid = false;
 };
+// The pair's χ² in each image through T12.
 PairChi2 pairChi2(const PinholeCamera<double>& camera, const SE3d& T12, const PointPair& pair);
 
+// The metric loop's RANSAC over relative poses.
 struct RelativePoseRansacOptions {
+  // @{
+  // Hypotheses, inliers required, and the χ² gate (99 %, 2 dof).
   int iterations = 300;
   int minInliers = 20;
   double inlierChi2 = 9.21;
+  // @}
 };
 
+// A verified relative pose between two keyframes.
 struct RelativePoseEstimate {
+  // @{
+  // Whether one was found, the pose, and which pairs agree with it.
   bool found = false;
   SE3d T12;
   std::vector<char> inliers;
   int inlierCount = 0;
+  // @}
 };
 
+// RANSAC over three-point rigid fits (Horn), scored by χ² in both images.
 RelativePoseEstimate estimateRelativePoseRansac(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera,
                                                 const RelativePoseRansacOptions& options, std::mt19937& rng);
 

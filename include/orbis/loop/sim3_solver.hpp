@@ -41,22 +41,31 @@ std::optional<Sim3d> alignSim3(const Eigen::Matrix3Xd& source, const Eigen::Matr
 // A pair's χ² in each image through S12 (see PairChi2); not valid behind either camera.
 PairChi2 pairChi2(const PinholeCamera<double>& camera, const Sim3d& S12, const PointPair& pair);
 
+// The Sim(3) RANSAC of loop detection (ORB-SLAM2's Sim3Solver).
 struct Sim3RansacOptions {
   int iterations = 300;     // ORB-SLAM2's cap
+  // @{
+  // Inliers required and the χ² gate (99 %, 2 dof).
   int minInliers = 20;
   double inlierChi2 = 9.21;
+  // @}
   double confidence = 0.99;  // early stop: P(a better hypothesis exists) below 1 − confidence
   bool fixScale = false;     // true: a rigid motion (a metric sensor's loop)
 };
 
+// A verified similarity between two keyframes.
 struct Sim3Estimate {
+  // @{
+  // Whether one was found, the similarity, and which pairs agree with it.
   bool found = false;
   Sim3d S12;
   std::vector<char> inliers;
   int inlierCount = 0;
+  // @}
   int iterations = 0;  // hypotheses drawn
 };
 
+// RANSAC over three-point similarity fits (Horn), scored by χ² in both images.
 Sim3Estimate estimateSim3Ransac(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera,
                                 const Sim3RansacOptions& options, std::mt19937& rng);
 

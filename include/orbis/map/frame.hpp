@@ -18,24 +18,37 @@
 
 namespace orbis {
 
+// A tracked frame: its features, pose and map-point matches, on the sensor's camera model.
 template <CameraModel Camera>
 struct Frame {
+  // Index in the input sequence.
   std::uint64_t index = 0;
+  // Seconds.
   double timestamp = 0;
+  // The frame's features (shared, immutable).
   std::shared_ptr<const FrameFeatures> features;
+  // The camera model (not owned).
   const Camera* camera = nullptr;
+  // The camera as the map file records it, and the image bounds.
   MapIntrinsics intrinsics;
 
+  // @{
+  // Bag of words and node-grouped features, computed on demand (relocalisation, keyframes).
   bow::BowVector bow;
   bow::FeatureVector featureVector;
   bool hasBow = false;
+  // @}
 
+  // Camera from world.
   SE3d Tcw;
   std::vector<MapPoint*> points;  // one slot per keypoint; null when unmatched
   std::vector<char> outlier;      // set by motion-only BA
 
+  // Keypoints (match slots).
   std::size_t size() const { return points.size(); }
+  // The camera centre in the world.
   Eigen::Vector3d cameraCenter() const { return Tcw.inverse().translation(); }
+  // Clears every match.
   void resetMatches() {
     points.assign(features ? features->size() : 0, nullptr);
     outlier.assign(points.size(), 0);
@@ -46,6 +59,7 @@ struct Frame {
     for (std::size_t i = 0; i < points.size(); ++i) n += (points[i] && !outlier[i]) ? 1 : 0;
     return n;
   }
+  // Whether keypoint i has a right coordinate or depth.
   bool isStereo(std::size_t i) const { return features->uRight[i] >= 0; }
   // Close points (paper §III-A) are trusted from one frame; a monocular camera has none.
   bool isClose(std::size_t i) const {

@@ -26,14 +26,21 @@ namespace orbis {
 // the close/far depth threshold and the image bounds keypoints may fall in. The pipeline reads
 // only the bounds (inImage); it projects through the sensor's compile-time camera model.
 struct MapIntrinsics {
+  // @{
+  // Pinhole intrinsics of the (undistorted, rectified) left image.
   double fx = 0, fy = 0, cx = 0, cy = 0;
+  // @}
   double bf = 0;          // baseline × fx; 0 for a monocular camera
   double closeDepth = 0;  // depth below which a stereo keypoint is "close" (40 × baseline)
   // A depth sensor's σ of the virtual disparity bf/d (px at level 0); 0 for a stereo pair. It
   // picks the residual BA gives the keypoint's depth (optim/reprojection.hpp).
   double disparitySigma = 0;
+  // @{
+  // The image bounds keypoints may fall in (undistorted pixels).
   double minX = 0, maxX = 0, minY = 0, maxY = 0;
+  // @}
 
+  // Whether (u, v) lies inside the bounds.
   bool inImage(double u, double v) const { return u >= minX && u < maxX && v >= minY && v < maxY; }
 };
 
@@ -49,37 +56,55 @@ bool pointFromDepth(const Camera& camera, const FrameFeatures& features, std::si
   return true;
 }
 
+// A keyframe: an immutable frame (features, bag of words), its pose, its map points and its place
+// in the covisibility graph, the spanning tree and the loop edges (§III-B).
 class KeyFrame {
  public:
   static constexpr int kCovisibilityThreshold = 15;  // shared points for an edge (ORB-SLAM)
 
+  // Made by Map::createKeyFrame.
   KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
            std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
            bow::BowVector bowVector, bow::FeatureVector featureVector);
 
+  // Unique, increasing with creation.
   const KeyFrameId id;
   const std::uint64_t frameIndex;  // index of the frame it was made from
+  // Seconds.
   const double timestamp;
+  // Its camera, as the map file records it.
   const MapIntrinsics intrinsics;
 
   // ---- immutable frame data --------------------------------------------------------------
+  // The frame's features (immutable).
   const FrameFeatures& features() const { return *features_; }
+  // @{
+  // Keypoints, the bag of words and the node-grouped features.
   std::size_t size() const { return points_.size(); }
   const bow::BowVector& bowVector() const { return bow_; }
   const bow::FeatureVector& featureVector() const { return featureVector_; }
+  // @}
 
   // ---- pose (camera-from-world) ------------------------------------------------------------
+  // Camera from world.
   const SE3d& Tcw() const { return Tcw_; }
+  // @{
+  // World from camera, the camera centre, and setting the pose.
   SE3d Twc() const { return Tcw_.inverse(); }
   Eigen::Vector3d cameraCenter() const { return Tcw_.inverse().translation(); }
   void setPose(const SE3d& Tcw) { Tcw_ = Tcw; }
+  // @}
 
   // ---- map-point associations ----------------------------------------------------------
+  // The map point of keypoint i, or null.
   MapPoint* point(std::size_t i) const { return points_[i]; }
+  // @{
+  // The map point of each keypoint (null: none); setting and erasing them.
   const std::vector<MapPoint*>& points() const { return points_; }
   void setPoint(std::size_t i, MapPoint* p) { points_[i] = p; }
   void erasePoint(std::size_t i) { points_[i] = nullptr; }
   void erasePoint(const MapPoint* p);
+  // @}
   // Map points with at least minObservations observations (ORB-SLAM's TrackedMapPoints).
   int trackedPoints(int minObservations) const;
   // Distinct good map points, ordered by id.
@@ -89,17 +114,27 @@ class KeyFrame {
   // Recomputes this keyframe's edges from its map points, updates the neighbours' edges, and,
   // the first time, attaches it to the spanning tree under its strongest neighbour.
   void updateConnections();
+  // @{
+  // Covisibility edges: add, erase, and the weight (shared points) to a keyframe.
   void addConnection(KeyFrame* kf, int weight);
   void eraseConnection(KeyFrame* kf);
   int weight(const KeyFrame* kf) const;
+  // @}
   // Neighbours by decreasing weight (ties broken by id).
   const std::vector<KeyFrame*>& covisibles() const { return orderedConnected_; }
+  // @{
+  // The n best neighbours, those with weight at least w, and every neighbour.
   std::vector<KeyFrame*> bestCovisibles(std::size_t n) const;
   std::vector<KeyFrame*> covisiblesWithWeightAtLeast(int w) const;
   std::set<KeyFrame*, ById> connectedSet() const;
+  // @}
 
   // ---- spanning tree and loop edges ----------------------------------------------------
+  // Its parent in the spanning tree (null for a map's root).
   KeyFrame* parent() const { return parent_; }
+  // @{
+  // Spanning-tree children and parent changes; loop edges (a keyframe with one is protected from
+  // culling).
   const std::set<KeyFrame*, ById>& children() const { return children_; }
   void changeParent(KeyFrame* parent);
   void addChild(KeyFrame* kf) { children_.insert(kf); }
@@ -107,15 +142,33 @@ class KeyFrame {
   bool hasChild(KeyFrame* kf) const { return children_.count(kf) != 0; }
   void addLoopEdge(KeyFrame* kf) { loopEdges_.insert(kf); protected_ = true; }
   const std::set<KeyFrame*, ById>& loopEdges() const { return loopEdges_; }
+  // @}
 
   // ---- life cycle ------------------------------------------------------------------------
+  // Whether it was culled.
   bool isBad() const { return bad_; }
   // Keyframes under loop-closing use are protected from culling.
   void setProtected(bool p) { protected_ = p || !loopEdges_.empty(); }
+  // Whether culling must spare it.
   bool isProtected() const { return protected_; }
   // Removes the keyframe from the graphs (re-parenting its children by covisibility, as ORB-SLAM
   // does) and detaches its map points. Returns false when it is protected or the root.
   bool setBad();
+
+  // @{
+  // ---- the atlas (map mutex held) --------------------------------------------------------
+  // The map of the atlas it belongs to (map.hpp); changes when its map is merged into another.
+  std::uint32_t mapId() const { return mapId_; }
+  void setMapId(std::uint32_t id) { mapId_ = id; }
+  // @}
+  // @{
+  // The first keyframe of its map: never culled. A gauge is a root BA keeps fixed; a root stops
+  // being one when its map is merged into another (that map's root holds the gauge).
+  bool isMapRoot() const { return mapRoot_; }
+  void setMapRoot(bool root) { mapRoot_ = root; gauge_ = root; }
+  bool isGauge() const { return gauge_; }
+  void setGauge(bool gauge) { gauge_ = gauge && mapRoot_; }
+  // @}
 
   // Relative pose to the parent recorded when the keyframe went bad, so trajectories can still
   // express frames referenced to it.
@@ -124,6 +177,7 @@ class KeyFrame {
   // Per-frame marks of the tracker (map mutex held): the frame, plus one, whose local map last
   // listed this keyframe, and how many of that frame's matches it observes.
   std::uint64_t inLocalMapOf = 0;
+  // How many of that frame's matches it observes.
   int sharedMatches = 0;
 
   // Indices of keypoints within radius r of (u, v) (undistorted pixels).
@@ -147,6 +201,8 @@ class KeyFrame {
   std::set<KeyFrame*, ById> loopEdges_;
   bool protected_ = false;
   bool bad_ = false;
+  std::uint32_t mapId_ = 0;
+  bool mapRoot_ = false, gauge_ = false;
 };
 
 }  // namespace orbis

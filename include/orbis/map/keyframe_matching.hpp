@@ -27,6 +27,8 @@
 
 namespace orbis::matching {
 
+// Matches the map points of kf1 to keypoints of kf2 sharing a vocabulary node (loop closing's first
+// search); returns the count.
 int matchKeyFramesByBow(const KeyFrame& kf1, const KeyFrame& kf2, std::vector<MapPoint*>& matches12,
                         float ratio = 0.75f);
 
@@ -35,10 +37,13 @@ template <CameraModel Camera>
 int matchByRelativePose(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const SE3d& T12,
                         std::vector<MapPoint*>& matches12, float radius = 7.5f);
 
+// Matches points of each keyframe projected into the other through the similarity S12 (loop
+// closing's guided search).
 template <CameraModel Camera>
 int matchBySim3(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2, const Sim3d& S12,
                 std::vector<MapPoint*>& matches12, float radius = 7.5f);
 
+// Matches points projected into keyframe kf at pose Tcw, within radius pixels (loop fusion).
 template <CameraModel Camera>
 int matchByProjection(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw, const std::vector<MapPoint*>& points,
                       std::vector<MapPoint*>& matches, float radius = 10.0f);

@@ -12,24 +12,32 @@
 
 namespace orbis {
 
+// What tracking and loop closing may ask of local mapping, so neither includes mapping/ (the layer
+// rule).
 class LocalMappingControl {
  public:
   virtual ~LocalMappingControl() = default;
 
   // Tracking (map mutex held): queue a new keyframe.
   virtual void insertKeyFrame(KeyFrame* kf) = 0;
+  // Keyframes waiting.
   virtual std::size_t queuedKeyFrames() const = 0;
   // False while mapping is busy with the keyframes it has.
   virtual bool acceptsKeyFrames() const = 0;
+  // Stops a running local BA at its next iteration.
   virtual void interruptBundleAdjustment() = 0;
 
   // Loop closing pauses local mapping while it corrects the map.
   virtual void requestStop() = 0;
+  // @{
+  // Whether mapping has stopped, or is stopping, for loop closing.
   virtual bool isStopped() const = 0;
   virtual bool isStoppedOrStopping() const = 0;
+  // @}
   // While set, a stop request is not honoured (tracking is creating a keyframe). Returns false
   // when mapping is already stopped.
   virtual bool setNotStop(bool flag) = 0;
+  // Lets stopped mapping go on.
   virtual void release() = 0;
 };
 

@@ -27,7 +27,7 @@ struct BaSnapshot {
 };
 
 // Builds the problem for `free` keyframes and `points`; keyframes outside `free` that observe the
-// points enter fixed. The origin keyframe is always fixed (gauge). Keypoints deeper than
+// points enter fixed. A map's root keyframe is always fixed (KeyFrame::isGauge). Keypoints deeper than
 // depthLimit are monocular observations (bundleAdjustmentDepthLimit). Caller holds the map mutex.
 inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, const std::vector<MapPoint*>& points,
                           double depthLimit) {
@@ -39,7 +39,7 @@ inline void buildSnapshot(BaSnapshot& s, const std::vector<KeyFrame*>& free, con
     s.poseFixed.push_back(fixed ? 1 : 0);
     return poseOf.emplace(kf, index).first;
   };
-  for (KeyFrame* kf : free) addPose(kf, kf->id == 0);
+  for (KeyFrame* kf : free) addPose(kf, kf->isGauge());
   for (MapPoint* p : points) {
     const int pointIndex = static_cast<int>(s.positions.size());
     s.points.push_back(p);
@@ -149,15 +149,15 @@ LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map,
 
 template <optim::RobustKernel Kernel, CameraModel Camera>
 FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
-                                                std::atomic<bool>* abort) {
+                                                std::atomic<bool>* abort, std::uint32_t mapId) {
   using namespace map_ba_detail;
   FullBundleAdjustmentResult result;
   BaSnapshot s;
   {
     std::lock_guard lock(map.mutex());
-    const auto keyFrames = map.keyFrames();
+    const auto keyFrames = map.keyFrames(mapId);
     if (keyFrames.empty()) return result;
-    buildSnapshot(s, keyFrames, map.mapPoints(), bundleAdjustmentDepthLimit(camera));
+    buildSnapshot(s, keyFrames, map.mapPoints(mapId), bundleAdjustmentDepthLimit(camera));
   }
   // Huber throughout, no outlier pass: the loop closer merges the result through the spanning tree.
   optim::BundleAdjustmentOptions options;

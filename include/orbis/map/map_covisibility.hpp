@@ -12,10 +12,13 @@
 
 namespace orbis {
 
+// The map's covisibility graph as the keyframe database queries it (bow::CovisibilityGraph).
 class MapCovisibility {
  public:
+  // A view of map.
   explicit MapCovisibility(const Map& map) : map_(map) {}
 
+  // Every good neighbour of a keyframe.
   std::vector<bow::KeyframeId> connectedKeyframes(bow::KeyframeId id) const {
     std::vector<bow::KeyframeId> out;
     if (const KeyFrame* kf = map_.keyFrame(id); kf && !kf->isBad())
@@ -24,6 +27,7 @@ class MapCovisibility {
     return out;
   }
 
+  // Up to n best good neighbours.
   std::vector<bow::KeyframeId> bestCovisibleKeyframes(bow::KeyframeId id, std::size_t n) const {
     std::vector<bow::KeyframeId> out;
     if (const KeyFrame* kf = map_.keyFrame(id); kf && !kf->isBad())

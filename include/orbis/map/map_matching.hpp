@@ -29,10 +29,17 @@ namespace orbis::matching {
 // Where a map point should appear in a frame, if it is in the frustum and within its
 // scale-invariance distance range and viewed at less than 60° from its mean direction.
 struct Projection {
+  // @{
+  // Predicted pixel and right coordinate (−1: none).
   float u = 0, v = 0, uRight = -1;
+  // @}
+  // Predicted pyramid level.
   int level = 0;
+  // Cosine between the ray and the point's mean viewing direction.
   float viewCos = 1;
 };
+// Predicts where a map point appears in a frame at pose Tcw; false outside the frustum, the
+// distance range or 60° of the mean direction.
 template <CameraModel Camera>
 bool projectIntoFrame(const Camera& camera, const MapIntrinsics& bounds, const MapPoint& point, const SE3d& Tcw,
                       const ScaleLevels& levels, Projection& out);

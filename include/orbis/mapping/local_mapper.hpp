@@ -28,16 +28,22 @@
 
 namespace orbis {
 
+// Local mapping's settings.
 struct LocalMapperOptions {
+  // Runs on its own thread (false: inline, deterministic mode).
   bool threaded = true;
   int triangulationNeighbours = 10;  // covisible keyframes searched for new points (stereo)
   double redundancyRatio = 0.9;      // keyframe culling: share of points seen elsewhere
+  // Whether redundant keyframes are culled.
   bool cullKeyFrames = true;
 };
 
+// Local mapping (§III-C/§VI): keyframe insertion, recent map point culling, new points by
+// triangulation (and from depth), fusion, local BA and keyframe culling.
 template <SensorConfiguration Sensor>
 class LocalMapper final : public LocalMappingControl {
  public:
+  // The sensor's camera model.
   using Camera = typename Sensor::Camera;
 
   // `camera` must outlive the mapper (the SLAM system owns it).
@@ -67,8 +73,10 @@ class LocalMapper final : public LocalMappingControl {
   void waitUntilIdle();
   // Threaded mode: the same for at most `budget`; true when idle.
   bool waitUntilIdleFor(std::chrono::steady_clock::duration budget);
+  // Finishes queued work and joins the thread.
   void shutdown();
 
+  // Where each processed keyframe goes next (loop closing).
   void setKeyFrameSink(std::function<void(KeyFrame*)> sink) { sink_ = std::move(sink); }
   // Called for each keyframe culling retires, with the map mutex held (keyframe database upkeep).
   void setCulledKeyFrameSink(std::function<void(KeyFrame*)> sink) { culledSink_ = std::move(sink); }

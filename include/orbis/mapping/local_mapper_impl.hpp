@@ -395,7 +395,7 @@ template <SensorConfiguration Sensor>
 void LocalMapper<Sensor>::cullKeyFrames(KeyFrame* kf) {
   const std::vector<KeyFrame*> neighbours = kf->covisibles();
   for (KeyFrame* k : neighbours) {
-    if (k->id == 0 || k->isBad() || k->isProtected()) continue;
+    if (k->isMapRoot() || k->isBad() || k->isProtected()) continue;
     const FrameFeatures& f = k->features();
     int points = 0, redundant = 0;
     for (std::size_t i = 0; i < k->size(); ++i) {

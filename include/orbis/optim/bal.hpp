@@ -21,13 +21,20 @@
 
 namespace orbis::optim {
 
+// BAL's reprojection residual: a 9-parameter camera (rotation vector, translation, f, k1, k2)
+// seeing a point; a user-defined residual on a Euclidean pose block.
 struct BalReprojection {
+  // @{
+  // A 9-dimensional Euclidean camera block, 2 residual rows, with a point.
   using PoseManifold = EuclideanManifold<9>;
   static constexpr int kDim = 2;
   static constexpr bool kHasPoint = true;
+  // @}
 
+  // The observed pixel (BAL's centred coordinates).
   Eigen::Vector2d measurement;
 
+  // Residual and Jacobians (either may be null).
   void evaluate(const Eigen::Matrix<double, 9, 1>& camera, const Eigen::Vector3d& point,
                 Eigen::Vector2d& r, Eigen::Matrix<double, 2, 9>* jCamera,
                 Eigen::Matrix<double, 2, 3>* jPoint) const {
@@ -60,6 +67,7 @@ struct BalReprojection {
   }
 };
 
+// A BAL problem as the solver holds it, Huber kernel on every observation.
 using BalBundleProblem = Problem<EuclideanManifold<9>, Term<BalReprojection, HuberKernel>>;
 
 // Builds the engine's problem from a BAL file's contents (nothing fixed, Huber δ on pixels).

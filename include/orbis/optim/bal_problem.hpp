@@ -14,18 +14,26 @@
 
 namespace orbis {
 
+// One BAL observation: camera and point indices and the measured pixel.
 struct BalObservation {
+  // @{
+  // Camera index, point index and pixel coordinates.
   int camera = 0;
   int point = 0;
   double x = 0.0;
   double y = 0.0;
+  // @}
 };
 
+// A BAL problem: cameras, points and observations.
 struct BalProblem {
   using Camera = Eigen::Matrix<double, 9, 1>;  // ω (3), t (3), f, k1, k2
+  // @{
+  // Cameras, points and observations.
   std::vector<Camera> cameras;
   std::vector<Eigen::Vector3d> points;
   std::vector<BalObservation> observations;
+  // @}
 };
 
 }  // namespace orbis

@@ -27,6 +27,7 @@ concept LinearizedModel = requires(M& m, double mu, double& decrease, double& st
   m.acceptCandidate();
 };
 
+// Minimises a linearised model by Levenberg–Marquardt (Nielsen's damping, Ceres' stopping rules).
 template <LinearizedModel M>
 SolverSummary levenbergMarquardt(M& model, const SolverOptions& options) {
   SolverSummary summary;

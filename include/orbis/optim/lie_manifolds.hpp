@@ -12,19 +12,31 @@
 
 namespace orbis::optim {
 
+// SE(3) poses with the left update exp(δ)·T.
 struct SE3Manifold {
+  // @{
+  // Six degrees of freedom: the value and its tangent.
   static constexpr int kDim = 6;
   using Value = SE3d;
   using Tangent = SE3d::Tangent;
+  // @}
+  // exp(δ)·x.
   static Value plus(const Value& x, const Tangent& delta) { return SE3d::exp(delta) * x; }
+  // Scale of x for the relative step test.
   static double squaredNorm(const Value& x) { return 1.0 + x.translation().squaredNorm(); }
 };
 
+// Sim(3) poses with the left update exp(δ)·S.
 struct Sim3Manifold {
+  // @{
+  // Seven degrees of freedom: the value and its tangent.
   static constexpr int kDim = 7;
   using Value = Sim3d;
   using Tangent = Sim3d::Tangent;
+  // @}
+  // exp(δ)·x.
   static Value plus(const Value& x, const Tangent& delta) { return Sim3d::exp(delta) * x; }
+  // Scale of x for the relative step test.
   static double squaredNorm(const Value& x) {
     return 1.0 + x.translation().squaredNorm() + x.scale() * x.scale();
   }

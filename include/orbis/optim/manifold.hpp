@@ -24,15 +24,22 @@ concept Manifold = requires(const typename M::Value& x,
   { M::squaredNorm(x) } -> std::convertible_to<double>;
 };
 
+// An N-dimensional Euclidean block (x + δ).
 template <int N>
 struct EuclideanManifold {
+  // @{
+  // Its dimension, value and tangent.
   static constexpr int kDim = N;
   using Value = Eigen::Matrix<double, N, 1>;
   using Tangent = Eigen::Matrix<double, N, 1>;
+  // @}
+  // x + δ.
   static Value plus(const Value& x, const Tangent& delta) { return x + delta; }
+  // ‖x‖².
   static double squaredNorm(const Value& x) { return x.squaredNorm(); }
 };
 
+// 3-D points.
 using PointManifold = EuclideanManifold<3>;
 
 // std::vector with Eigen's aligned allocator: the fixed-size blocks stored here are

@@ -17,13 +17,17 @@ namespace orbis::optim {
 // One residual for both groups: Manifold is SE3Manifold or Sim3Manifold.
 template <class Manifold>
 struct RelativePose {
+  // @{
+  // The manifold, its group, the residual's size (the tangent's) and no point.
   using PoseManifold = Manifold;
   using Group = typename Manifold::Value;
   static constexpr int kDim = Manifold::kDim;
   static constexpr bool kHasPoint = false;
+  // @}
 
   Group measurement;  // T_ij (or S_ij)
 
+  // r = log(T_ij⁻¹ · T_i · T_j⁻¹), with its Jacobians (either may be null).
   void evaluate(const Group& poseI, const Group& poseJ, Eigen::Matrix<double, kDim, 1>& r,
                 Eigen::Matrix<double, kDim, kDim>* jI, Eigen::Matrix<double, kDim, kDim>* jJ) const {
     const Group inverseMeasurement = measurement.inverse();
@@ -33,7 +37,10 @@ struct RelativePose {
   }
 };
 
+// @{
+// The residual for SE(3) and Sim(3) pose graphs.
 using RelativePoseSE3 = RelativePose<SE3Manifold>;
 using RelativePoseSim3 = RelativePose<Sim3Manifold>;
+// @}
 
 }  // namespace orbis::optim

@@ -29,6 +29,8 @@
 
 namespace orbis::optim {
 
+// A sparse bundle-adjustment problem: poses on manifold PoseM, 3-D points, and residual terms whose
+// types and kernels are fixed at compile time; points are eliminated by a Schur complement.
 template <Manifold PoseM, class... Terms>
 class Problem {
   static_assert(sizeof...(Terms) > 0, "a problem needs at least one residual term");
@@ -36,6 +38,8 @@ class Problem {
                 "every residual must be written against the problem's pose manifold");
 
  public:
+  // @{
+  // The pose type and size, the number of terms, and the term and residual types by index.
   using Pose = typename PoseM::Value;
   static constexpr int kPoseDim = PoseM::kDim;
   static constexpr std::size_t kNumTerms = sizeof...(Terms);
@@ -43,12 +47,15 @@ class Problem {
   using TermAt = std::tuple_element_t<I, std::tuple<Terms...>>;
   template <std::size_t I>
   using ResidualAt = typename TermAt<I>::Residual;
+  // @}
 
+  // Adds a pose (fixed: held constant); returns its index.
   int addPose(const Pose& pose, bool fixed = false) {
     poses_.push_back(pose);
     poseFixed_.push_back(fixed);
     return static_cast<int>(poses_.size()) - 1;
   }
+  // Adds a point (fixed: held constant); returns its index.
   int addPoint(const Eigen::Vector3d& point, bool fixed = false) {
     points_.push_back(point);
     pointFixed_.push_back(fixed);
@@ -65,6 +72,8 @@ class Problem {
     return {term, static_cast<int>(records.size()) - 1};
   }
 
+  // @{
+  // Poses and points: counts, values and fixed flags, read and set.
   int numPoses() const { return static_cast<int>(poses_.size()); }
   int numPoints() const { return static_cast<int>(points_.size()); }
   const Pose& pose(int i) const { return poses_[i]; }
@@ -75,7 +84,10 @@ class Problem {
   bool pointFixed(int i) const { return pointFixed_[i] != 0; }
   void setPoseFixed(int i, bool fixed) { poseFixed_[i] = fixed; }
   void setPointFixed(int i, bool fixed) { pointFixed_[i] = fixed; }
+  // @}
 
+  // @{
+  // The stored residual blocks of term I.
   template <std::size_t I>
   const AlignedVector<ResidualRecord<ResidualAt<I>>>& records() const {
     return std::get<I>(records_);
@@ -84,7 +96,9 @@ class Problem {
   AlignedVector<ResidualRecord<ResidualAt<I>>>& records() {
     return std::get<I>(records_);
   }
+  // @}
 
+  // Switches a residual on or off (outliers are switched off).
   void setActive(ResidualId id, bool active) {
     visitTerm(id.term, [&](auto& records) { records[id.index].active = active; });
   }
@@ -92,6 +106,7 @@ class Problem {
   void setKernelThreshold(ResidualId id, double delta2) {
     visitTerm(id.term, [&](auto& records) { records[id.index].delta2 = delta2; });
   }
+  // Whether a residual is on.
   bool active(ResidualId id) const {
     bool result = false;
     visitTerm(id.term, [&](const auto& records) { result = records[id.index].active; });
@@ -109,6 +124,7 @@ class Problem {
   // ½Σρ over active residuals at the current values.
   double cost() const { return evaluateCost(poses_, points_); }
 
+  // Solves by Levenberg–Marquardt from the current values, which it updates.
   SolverSummary solve(const SolverOptions& options = {}) {
     prepare(options);
     SolverSummary summary = levenbergMarquardt(*this, options);
@@ -117,21 +133,29 @@ class Problem {
   }
 
   // ---- LinearizedModel interface (used by levenbergMarquardt) ----
+  // Whether any pose or point is free (the LinearizedModel interface levenbergMarquardt drives,
+  // from here on).
   bool hasFreeVariables() const { return !freePoseIds_.empty() || !freePointIds_.empty(); }
+  // Evaluates residuals and Jacobians at the current values and builds the normal equations;
+  // returns the cost.
   double linearize();
+  // The largest gradient entry.
   double maxGradient() const {
     double g = 0.0;
     if (poseRhs_.size() > 0) g = poseRhs_.cwiseAbs().maxCoeff();
     for (const auto& b : pointRhs_) g = std::max(g, b.cwiseAbs().maxCoeff());
     return g;
   }
+  // Solves the damped system for a step; false when it failed numerically.
   bool solveDamped(double mu, double& predictedDecrease, double& stepNorm);
+  // Norm of the current parameters.
   double parameterNorm() const {
     double sq = 0.0;
     for (int p : freePoseIds_) sq += PoseM::squaredNorm(poses_[p]);
     for (int l : freePointIds_) sq += points_[l].squaredNorm();
     return std::sqrt(sq);
   }
+  // Cost at the current values plus the last step.
   double candidateCost() {
     for (std::size_t k = 0; k < freePoseIds_.size(); ++k) {
       const int p = freePoseIds_[k];
@@ -143,6 +167,7 @@ class Problem {
     }
     return evaluateCost(candidatePoses_, candidatePoints_);
   }
+  // Makes the last step the current values.
   void acceptCandidate() {
     // Only free entries differ between the two arrays, so swapping keeps fixed values intact.
     std::swap(poses_, candidatePoses_);

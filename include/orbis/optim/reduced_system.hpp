@@ -22,15 +22,21 @@ namespace orbis::optim {
 
 // Where block (i, j), i ≤ j, lives: block column j, i being its position-th stored row block.
 struct BlockSlot {
+  // @{
+  // The block column and the row block's position in it.
   int column = -1;
   int position = 0;
+  // @}
 };
 
 // Collects the non-zero block pattern without duplicates (a bitmap for modest sizes).
 class BlockPatternBuilder {
  public:
+  // Starts a pattern of numBlocks × numBlocks blocks.
   void reset(int numBlocks);
+  // Marks block (i, j) non-zero.
   void add(int i, int j);
+  // Blocks per side.
   int numBlocks() const { return n_; }
   // Row blocks above the diagonal of each block column, sorted.
   std::vector<std::vector<int>> rowsAboveDiagonal() const;
@@ -41,18 +47,28 @@ class BlockPatternBuilder {
   std::vector<std::vector<int>> lists_;  // used when n is too large for a bitmap
 };
 
+// The reduced camera system after the Schur complement, stored by block columns, solved dense
+// (small) or by CHOLMOD.
 class ReducedCameraSystem {
  public:
+  // Lays out the storage for a pattern; kind and denseThreshold choose the solver.
   void setPattern(const BlockPatternBuilder& pattern, int blockDim, LinearSolverKind kind,
                   int denseThreshold);
+  // @{
+  // Unknowns, blocks per side, and whether CHOLMOD solves it.
   int size() const { return n_ * blockDim_; }
   int numBlocks() const { return n_; }
   bool usesSparse() const { return sparse_; }
+  // @}
   BlockSlot slot(int i, int j) const;  // requires i < j and the pair in the pattern
+  // Where diagonal block j lives.
   BlockSlot diagonalSlot(int j) const { return {j, static_cast<int>(rowsAbove_[j].size())}; }
 
+  // @{
+  // The stored values, and zeroing them.
   std::vector<double>& values() { return values_; }
   void setZero() { std::fill(values_.begin(), values_.end(), 0.0); }
+  // @}
 
   // Adds B to block (i, j) of an off-diagonal slot (i < j).
   template <int D, class Derived>

@@ -16,16 +16,24 @@
 
 namespace orbis::optim {
 
+// A point seen by a camera model: r = camera.project(T·X) − measurement, with analytic Jacobians
+// for the pose (left update) and the point.
 template <CameraModel Camera>
 struct Reprojection {
+  // @{
+  // An SE(3) pose with a point; rows: the camera's observation size.
   using PoseManifold = SE3Manifold;
   static constexpr int kDim = Camera::kObservationDim;
   static constexpr bool kHasPoint = true;
   using Observation = Eigen::Matrix<double, kDim, 1>;
+  // @}
 
+  // The observed keypoint, (u, v) or (uL, v, uR).
   Observation measurement;
+  // The camera model (not owned).
   const Camera* camera = nullptr;
 
+  // Residual and Jacobians (either may be null).
   void evaluate(const SE3d& cameraFromWorld, const Eigen::Vector3d& pointWorld, Observation& r,
                 Eigen::Matrix<double, kDim, 6>* jPose, Eigen::Matrix<double, kDim, 3>* jPoint) const {
     const Eigen::Vector3d pc = cameraFromWorld * pointWorld;
@@ -40,9 +48,12 @@ struct Reprojection {
   }
 };
 
+// @{
+// The reprojection residuals of the shipped cameras.
 using MonoReprojection = Reprojection<PinholeCamera<double>>;
 using StereoReprojection = Reprojection<RectifiedStereoCamera<double>>;
 using RgbdReprojection = Reprojection<RgbdCamera<double>>;
+// @}
 
 // A depth sensor's observation. Its virtual right coordinate uR = uL − bf/d is the measured uL
 // minus a disparity from the sensor, so uR's error is uL's error plus the sensor's: the stereo
@@ -55,15 +66,22 @@ using RgbdReprojection = Reprojection<RgbdCamera<double>>;
 template <CameraModel Camera>
 struct DisparityReprojection {
   static_assert(Camera::kObservationDim == 3, "the disparity residual needs a (uL, v, uR) camera");
+  // @{
+  // An SE(3) pose with a point; three rows.
   using PoseManifold = SE3Manifold;
   static constexpr int kDim = 3;
   static constexpr bool kHasPoint = true;
   using Observation = Eigen::Vector3d;
+  // @}
 
+  // The observed (uL, v, uR).
   Observation measurement;
+  // The camera model (not owned).
   const Camera* camera = nullptr;
+  // σ(keypoint) / σ(disparity).
   double disparityWeight = 1.0;
 
+  // Residual and Jacobians (either may be null).
   void evaluate(const SE3d& cameraFromWorld, const Eigen::Vector3d& pointWorld, Observation& r,
                 Eigen::Matrix<double, 3, 6>* jPose, Eigen::Matrix<double, 3, 3>* jPoint) const {
     // The stereo residual, then its third row replaced by w·(row uL − row uR): a linear map, so
@@ -76,6 +94,7 @@ struct DisparityReprojection {
   }
 };
 
+// The disparity residual on a stereo camera model.
 using DepthReprojection = DisparityReprojection<RectifiedStereoCamera<double>>;
 
 // The same projection seen from the other end of a relative pose: the pose variable T is
@@ -85,14 +104,20 @@ using DepthReprojection = DisparityReprojection<RectifiedStereoCamera<double>>;
 // pairs it with Reprojection (camera 1 observing camera 2's point through T).
 template <CameraModel Camera>
 struct InversePoseReprojection {
+  // @{
+  // An SE(3) pose with a point; rows: the camera's observation size.
   using PoseManifold = SE3Manifold;
   static constexpr int kDim = Camera::kObservationDim;
   static constexpr bool kHasPoint = true;
   using Observation = Eigen::Matrix<double, kDim, 1>;
+  // @}
 
+  // Camera 2's observed keypoint.
   Observation measurement;
+  // The camera model (not owned).
   const Camera* camera = nullptr;
 
+  // Residual and Jacobians (either may be null).
   void evaluate(const SE3d& T, const Eigen::Vector3d& point, Observation& r, Eigen::Matrix<double, kDim, 6>* jPose,
                 Eigen::Matrix<double, kDim, 3>* jPoint) const {
     const SE3d inverse = T.inverse();

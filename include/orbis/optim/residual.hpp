@@ -19,12 +19,15 @@
 
 namespace orbis::optim {
 
+// @{
+// A residual's vector and its Jacobians for the pose and the point.
 template <class R>
 using ResidualVector = Eigen::Matrix<double, R::kDim, 1>;
 template <class R>
 using PoseJacobian = Eigen::Matrix<double, R::kDim, R::PoseManifold::kDim>;
 template <class R>
 using PointJacobian = Eigen::Matrix<double, R::kDim, 3>;
+// @}
 
 template <class R>
 concept PointResidual = Manifold<typename R::PoseManifold> && R::kHasPoint &&
@@ -49,25 +52,34 @@ concept ResidualBlock = PointResidual<R> || PoseResidual<R>;
 // Term<Stereo, HuberKernel>>.
 template <ResidualBlock R, RobustKernel K = TrivialKernel>
 struct Term {
+  // @{
+  // The residual and kernel types.
   using Residual = R;
   using Kernel = K;
+  // @}
 };
 
 // A residual block as stored in a problem.
 template <class R>
 struct ResidualRecord {
+  // The residual.
   R residual;
   int pose = -1;   // the observing pose, or pose i of a pose-graph edge
   int other = -1;  // the point (PointResidual) or pose j (PoseResidual)
+  // 1/σ².
   double information = 1.0;
   double delta2 = std::numeric_limits<double>::infinity();  // kernel threshold δ²
+  // Whether it takes part in the solve.
   bool active = true;
 };
 
 // Handle returned by Problem::add: which term, which record of it.
 struct ResidualId {
+  // @{
+  // The term and the record's index in it.
   int term = -1;
   int index = -1;
+  // @}
 };
 
 }  // namespace orbis::optim

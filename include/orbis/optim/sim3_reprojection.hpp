@@ -18,16 +18,23 @@
 
 namespace orbis::optim {
 
+// Loop closing's Sim(3) fit: a point of keyframe 2 seen by keyframe 1 through S12.
 template <CameraModel Camera>
 struct Sim3Reprojection {
+  // @{
+  // A Sim(3) pose with a point; rows: the camera's observation size.
   using PoseManifold = Sim3Manifold;
   static constexpr int kDim = Camera::kObservationDim;
   static constexpr bool kHasPoint = true;
   using Observation = Eigen::Matrix<double, kDim, 1>;
+  // @}
 
+  // The keypoint observed in keyframe 1.
   Observation measurement;
+  // The camera model (not owned).
   const Camera* camera = nullptr;
 
+  // Residual and Jacobians (either may be null).
   void evaluate(const Sim3d& S12, const Eigen::Vector3d& point, Observation& r, Eigen::Matrix<double, kDim, 7>* jPose,
                 Eigen::Matrix<double, kDim, 3>* jPoint) const {
     const Eigen::Vector3d q = S12 * point;
@@ -40,16 +47,23 @@ struct Sim3Reprojection {
   }
 };
 
+// The other direction: a point of keyframe 1 seen by keyframe 2 through S12⁻¹.
 template <CameraModel Camera>
 struct InverseSim3Reprojection {
+  // @{
+  // A Sim(3) pose with a point; rows: the camera's observation size.
   using PoseManifold = Sim3Manifold;
   static constexpr int kDim = Camera::kObservationDim;
   static constexpr bool kHasPoint = true;
   using Observation = Eigen::Matrix<double, kDim, 1>;
+  // @}
 
+  // The keypoint observed in keyframe 2.
   Observation measurement;
+  // The camera model (not owned).
   const Camera* camera = nullptr;
 
+  // Residual and Jacobians (either may be null).
   void evaluate(const Sim3d& S12, const Eigen::Vector3d& point, Observation& r, Eigen::Matrix<double, kDim, 7>* jPose,
                 Eigen::Matrix<double, kDim, 3>* jPoint) const {
     const Sim3d S21 = S12.inverse();
@@ -64,7 +78,10 @@ struct InverseSim3Reprojection {
   }
 };
 
+// @{
+// The pinhole instances loop closing uses.
 using MonoSim3Reprojection = Sim3Reprojection<PinholeCamera<double>>;
 using MonoInverseSim3Reprojection = InverseSim3Reprojection<PinholeCamera<double>>;
+// @}
 
 }  // namespace orbis::optim

@@ -30,59 +30,84 @@
 
 namespace orbis::optim {
 
+// One keypoint's observation of a map point, as the BA over the map builds it.
 struct SlamObservation {
   int pose = 0;                  // index into the poses (always 0 for motion-only BA)
   int point = 0;                 // index into the points
   Eigen::Vector3d measurement;   // (uL, v, uR); uR < 0: monocular
   double information = 1.0;      // 1/σ², ORB-SLAM: 1/scaleFactor^(2·octave)
+  // Whether the observation has a right coordinate.
   bool isStereo() const { return measurement.z() >= 0.0; }
 };
 
+// ORB-SLAM2's motion-only BA schedule.
 struct MotionOnlyOptions {
+  // @{
+  // Rounds and iterations per round.
   int rounds = 4;
   int iterationsPerRound = 10;
+  // @}
   int robustRounds = 3;  // Huber in the first three rounds, the last one without (ORB-SLAM2)
   // Each round starts again from the prior pose, with the inliers of the round before (ORB-SLAM2):
   // a round that outliers dragged off does not hand its pose on.
   double chi2Mono = kChi2Mono;
+  // χ² threshold of stereo observations.
   double chi2Stereo = kChi2Stereo;
+  // Each round starts from the prior pose.
   bool restartEachRound = true;
 };
 
+// The result of a motion-only BA.
 struct MotionOnlyResult {
+  // Observations within the χ² gates after the last round.
   int inliers = 0;
   std::vector<char> outlier;  // per observation
+  // The last round's solver summary.
   SolverSummary lastRound;
 };
 
+// Local and full BA settings.
 struct BundleAdjustmentOptions {
   int iterations = 5;            // the robust pass (ORB-SLAM local BA: 5; full BA: 10 or 20)
   int refineIterations = 10;     // after removing outliers, without kernel (local BA: 10; 0 = skip)
+  // @{
+  // χ² thresholds of monocular and stereo observations.
   double chi2Mono = kChi2Mono;
   double chi2Stereo = kChi2Stereo;
+  // @}
+  // Stops the solve from another thread when set (a new keyframe for local mapping).
   const std::atomic<bool>* abortFlag = nullptr;
+  // Dense, sparse or automatic.
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   // When set, receives the problem in BAL form before solving (write it with io/bal.hpp's
   // writeBal for replay with `orbis ba`).
   std::function<void(const BalProblem&)> inspectBal;
 };
 
+// The result of a BA.
 struct BundleAdjustmentResult {
   std::vector<char> outlier;  // per observation, after the last pass
+  // @{
+  // Solver summaries of the robust pass and the refinement.
   SolverSummary robustPass;
   SolverSummary refinePass;
+  // @}
 };
 
 // The residual of a camera model's 3-D observations: ORB-SLAM's (uL, v, uR) for a stereo pair,
 // the whitened disparity for a depth sensor (its uR is uL minus the sensor's disparity).
 template <CameraModel Camera>
 struct MetricResidualFor {
+  // The reprojection residual, for stereo pairs.
   using type = Reprojection<Camera>;
 };
+// Depth cameras use the disparity residual.
 template <>
 struct MetricResidualFor<RgbdCamera<double>> {
+  // The disparity residual.
   using type = DisparityReprojection<RgbdCamera<double>>;
 };
+// The residual a camera model's 3-D observations use.
 template <CameraModel Camera>
 using MetricResidual = typename MetricResidualFor<Camera>::type;
 
@@ -90,21 +115,27 @@ using MetricResidual = typename MetricResidualFor<Camera>::type;
 // each under the robust kernel Kernel.
 template <CameraModel Camera, RobustKernel Kernel>
 struct SlamProblemFor {
+  // A monocular and a metric term.
   using type = Problem<SE3Manifold, Term<MonoReprojection, Kernel>, Term<MetricResidual<Camera>, Kernel>>;
 };
+// A monocular camera: one term.
 template <CameraModel Camera, RobustKernel Kernel>
   requires(Camera::kObservationDim == 2)
 struct SlamProblemFor<Camera, Kernel> {
+  // The monocular term only.
   using type = Problem<SE3Manifold, Term<MonoReprojection, Kernel>>;
 };
+// The problem type of camera model Camera under kernel Kernel.
 template <CameraModel Camera, RobustKernel Kernel = HuberKernel>
 using SlamProblem = typename SlamProblemFor<Camera, Kernel>::type;
 
 // The same problem type with every term's kernel replaced by TrivialKernel.
 template <class P>
 struct WithoutKernelFor;
+// The problem with TrivialKernel in every term.
 template <Manifold M, class... Residuals, class... Kernels>
 struct WithoutKernelFor<Problem<M, Term<Residuals, Kernels>...>> {
+  // The kernel-free problem type.
   using type = Problem<M, Term<Residuals, TrivialKernel>...>;
 };
 

@@ -13,29 +13,40 @@
 
 namespace orbis::optim {
 
+// How the reduced camera system is solved.
 enum class LinearSolverKind {
   Automatic,       // dense below denseThreshold unknowns in the reduced camera system, else sparse
   DenseCholesky,   // Eigen LLT of the reduced camera system
   SparseCholesky,  // CHOLMOD supernodal; ordering and symbolic analysis once per solve
 };
 
+// Levenberg–Marquardt settings (Ceres' defaults where not noted).
 struct SolverOptions {
+  // @{
+  // Iteration cap, and stopping tolerances on the relative cost decrease, the step and the
+  // gradient.
   int maxIterations = 50;
   double functionTolerance = 1e-6;
   double parameterTolerance = 1e-8;
   double gradientTolerance = 1e-10;
+  // @}
   // μ₀ = 1/initialTrustRadius; Ceres' default radius is 1e4.
   double initialTrustRadius = 1e4;
   // A step is accepted when actual/predicted decrease exceeds this (Ceres: 1e-3).
   double minRelativeDecrease = 1e-3;
   // Bounds on the Marquardt diagonal, as Ceres' min/max_lm_diagonal.
   double minDiagonal = 1e-6;
+  // Upper bound of the Marquardt diagonal.
   double maxDiagonal = 1e32;
+  // The reduced system's solver.
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
+  // Unknowns from which Automatic uses CHOLMOD.
   int denseThreshold = 400;
+  // Stops the solve from another thread when set.
   const std::atomic<bool>* abortFlag = nullptr;
 };
 
+// Why a solve stopped.
 enum class Termination {
   FunctionTolerance,
   ParameterTolerance,
@@ -46,6 +57,7 @@ enum class Termination {
   NoFreeVariables,
 };
 
+// The reason's name.
 inline const char* toString(Termination t) {
   switch (t) {
     case Termination::FunctionTolerance: return "function_tolerance";
@@ -59,13 +71,21 @@ inline const char* toString(Termination t) {
   return "unknown";
 }
 
+// What a solve did.
 struct SolverSummary {
+  // @{
+  // Cost ½Σρ before and after.
   double initialCost = 0.0;
   double finalCost = 0.0;
+  // @}
   int iterations = 0;        // linear solves attempted (accepted + rejected steps)
+  // Accepted steps.
   int successfulSteps = 0;
+  // Why it stopped.
   Termination termination = Termination::MaxIterations;
+  // Whether CHOLMOD solved the reduced system.
   bool usedSparseSolver = false;
+  // Whether a tolerance stopped it.
   bool converged() const {
     return termination == Termination::FunctionTolerance ||
            termination == Termination::ParameterTolerance ||

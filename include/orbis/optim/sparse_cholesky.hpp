@@ -13,18 +13,25 @@
 
 namespace orbis::optim {
 
+// CHOLMOD's supernodal Cholesky of a symmetric positive-definite matrix (upper triangle, compressed
+// columns): symbolic analysis once per pattern, numeric factorisation per solve.
 class SparseCholesky {
  public:
   SparseCholesky();
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
+  // @{
+  // Movable, not copyable.
   SparseCholesky(SparseCholesky&&) noexcept;
   SparseCholesky& operator=(SparseCholesky&&) noexcept;
+  // @}
 
   // columnStarts has n+1 entries; rowIndices columnStarts[n] entries, each ≤ its column.
   void analyze(int n, std::span<const int> columnStarts, std::span<const int> rowIndices);
+  // Whether analyze() has run.
   bool analyzed() const;
+  // Factorises with new values in the analysed pattern; false when not positive definite.
   bool factorize(std::span<const double> values);
   // solution may alias rhs.
   bool solve(std::span<const double> rhs, std::span<double> solution);

@@ -28,17 +28,26 @@
 
 namespace orbis {
 
+// A monocular frame.
 struct MonocularInput {
+  // Seconds.
   double timestamp = 0;
   cv::Mat image;  // 8-bit grey or BGR, as the lens took it (the builder undistorts keypoints)
 };
 
+// A stereo frame.
 struct StereoInput {
+  // Seconds.
   double timestamp = 0;
+  // @{
+  // The left and right images.
   cv::Mat left, right;  // rectified, 8-bit grey or BGR
+  // @}
 };
 
+// An RGB-D frame.
 struct RgbdInput {
+  // Seconds.
   double timestamp = 0;
   cv::Mat image;  // 8-bit grey or BGR
   cv::Mat depth;  // CV_32F metres, or CV_16U raw (divided by the camera's depthScale); 0 = none
@@ -58,30 +67,31 @@ concept SensorConfiguration = requires(typename S::FeatureBuilder& builder, cons
 
 // A rectified stereo pair: ORB on both images, then stereo matching along rows (§III-A); the
 // two extractions run in parallel. OrbParams::rightFeaturesFactor (settings key
-// ORBextractor.rightFeaturesFactor) scales the right image's budget. With ORB-SLAM2's equal
-// budgets the two quadtrees keep different corners, and 55% of left keypoints find a partner
-// on the synthetic room; 3x gives 71% at the same disparity accuracy
-// (tests/features/synthetic_stereo_test.cpp). But more stereo points mean more tracked close
-// points, so the paper's keyframe rule (fewer than 100 tracked close points) fires less: on the
-// synthetic stereo loop 3x made 52/50/44 keyframes instead of 68/60/53 and measured worse
-// (benchmarks/eval_accuracy.sh: 39.9 against 28.1 mm closed, 92.1 against 69.1 mm open; KITTI
-// 06 52.7 against 53.5 mm). Raising that threshold to 140 restored the keyframes and most of
-// the accuracy (31.8 / 65.6 mm), which confirms the cause. Four more rendered stereo loops
-// (seeds 31-34, budget 800) agree: 3x made 36-40 keyframes instead of 44-50, 36.0 against
-// 29.5 mm closed, 87.8 against 79.0 mm open (geometric means). The default keeps ORB-SLAM2's
-// equal budgets and the paper's rule.
+// ORBextractor.rightFeaturesFactor) scales the right image's budget. The default keeps
+// ORB-SLAM2's equal budgets: a larger right budget matches more keypoints but, through the
+// paper's keyframe rule, makes fewer keyframes and measured worse
+// (docs/notes/2026-11-23-stereo-right-features-factor.md).
 struct Stereo {
+  // @{
+  // The rectified pair's camera and its input.
   using Camera = RectifiedStereoCamera<double>;
   using Input = StereoInput;
+  // @}
   using RobustKernel = optim::HuberKernel;  // ORB-SLAM2's, with χ² 95% thresholds
+  // @{
+  // Stereo measures metric depth itself, from the disparity.
   static constexpr SensorKind kKind = SensorKind::Stereo;
   static constexpr bool kMetricScale = true;
   static constexpr bool kDepthFromSensor = false;
+  // @}
 
+  // ORB on both images (in parallel), then stereo matching along rows.
   class FeatureBuilder {
    public:
+    // Extractors for the left image and (rightFeaturesFactor times the budget) the right.
     FeatureBuilder(const Camera& camera, const OrbParams& orb)
         : camera_(camera), left_(orb), right_(rightParams(orb)) {}
+    // The frame's features.
     FrameFeatures build(const Input& in) { return extractStereo(left_, right_, in.left, in.right, camera_, matcher_); }
 
    private:
@@ -97,18 +107,27 @@ struct Stereo {
 
 // An RGB-D camera: ORB on the colour image, depth turned into a virtual right coordinate.
 struct Rgbd {
+  // @{
+  // The depth camera, its input and ORB-SLAM2's Huber kernel.
   using Camera = RgbdCamera<double>;
   using Input = RgbdInput;
   using RobustKernel = optim::HuberKernel;
+  // @}
+  // @{
+  // Depth comes from the sensor, in metres.
   static constexpr SensorKind kKind = SensorKind::Rgbd;
   static constexpr bool kMetricScale = true;
   static constexpr bool kDepthFromSensor = true;
+  // @}
 
+  // ORB on the colour image, depth looked up per keypoint.
   class FeatureBuilder {
    public:
+    // An extractor for the colour image.
     FeatureBuilder(const Camera& camera, const OrbParams& orb) : camera_(camera), metric_(camera), extractor_(orb) {
       metric_.depthScale = 1.0;
     }
+    // The frame's features.
     FrameFeatures build(const Input& in) {
       return extractRgbd(extractor_, in.image, in.depth, in.depth.depth() == CV_32F ? metric_ : camera_);
     }
@@ -131,23 +150,36 @@ struct Rgbd {
 // initialisation takes as many frames as the motion needs (a pure rotation never initialises),
 // and a reset needs the larger budget again. A new builder starts initialising.
 struct Monocular {
+  // @{
+  // The camera, its input and ORB-SLAM2's Huber kernel.
   using Camera = PinholeCamera<double>;
   using Input = MonocularInput;
   using RobustKernel = optim::HuberKernel;
+  // @}
+  // @{
+  // No metric scale, no depth.
   static constexpr SensorKind kKind = SensorKind::Monocular;
   static constexpr bool kMetricScale = false;
   static constexpr bool kDepthFromSensor = false;
+  // @}
+  // The initialisation budget: times the features while initialising.
   static constexpr int kInitialisationBudgetFactor = 2;
 
+  // ORB on the image, keypoints undistorted with the lens; twice the budget while initialising.
   class FeatureBuilder {
    public:
+    // lens: the images' distortion (zero when they are undistorted).
     FeatureBuilder(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens = {})
         : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {}
+    // The frame's features.
     FrameFeatures build(const Input& in) {
       return extractMonocular(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, camera_, lens_);
     }
+    // @{
+    // Whether the builder uses the initialisation budget (set by the tracker's owner).
     void setInitialising(bool initialising) { isInitialising_ = initialising; }
     bool initialising() const { return isInitialising_; }
+    // @}
 
    private:
     static OrbParams initialisationParams(OrbParams orb) {

@@ -22,20 +22,33 @@
 
 namespace orbis::synth {
 
+// How the rendered camera moves: along the loop, rotating in place, or not at all.
 enum class PathMotion { Loop, PureRotation, Static };
 
+// The camera path of a rendered sequence: an ellipse at a height, with gentle height, yaw, pitch
+// and roll waves.
 struct LoopTrajectoryParams {
+  // Loop, pure rotation or static.
   PathMotion motion = PathMotion::Loop;
+  // The ellipse's centre on the floor, metres.
   Eigen::Vector2d centre{0.0, 0.0};
+  // @{
+  // The ellipse's half axes.
   double radiusX = 2.0, radiusY = 1.5;   // metres
+  // @}
   double height = 1.4;                   // metres above z = 0
+  // Height wave amplitude, metres.
   double heightAmplitude = 0.15;
   double yawOffset = 0.6;                // radians, turned outwards from the direction of travel
   double yawAmplitude = 0.08;            // radians
+  // @{
+  // Pitch and roll wave amplitudes, radians.
   double pitchAmplitude = 0.08;
   double rollAmplitude = 0.05;
+  // @}
 };
 
+// The left camera's pose (world from camera) at phase in [0, 1) of the loop.
 inline SE3d loopPose(const LoopTrajectoryParams& p, double phase) {
   // Along the loop the whole pose moves with the phase; the degenerate motions freeze it at 0.
   const double a = p.motion == PathMotion::Loop ? 2.0 * M_PI * phase : 0.0;

@@ -11,10 +11,14 @@
 
 namespace orbis::synth {
 
+// SplitMix64: a small, fast generator whose sequence is the same on every platform (rendered data
+// must not depend on the standard library).
 class SynthRng {
  public:
+  // A generator from a seed.
   explicit SynthRng(std::uint64_t seed) : state_(seed) {}
 
+  // The next 64 random bits.
   std::uint64_t next() {
     std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
@@ -23,6 +27,7 @@ class SynthRng {
   }
   // Uniform in [0, 1) with 53 random bits.
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  // Uniform in [lo, hi).
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
   // Uniform integer in [lo, hi]; the modulo bias is below 2^-40 for the ranges used here.
   int uniformInt(int lo, int hi) {

@@ -23,24 +23,30 @@
 
 namespace orbis::synth {
 
+// An axis-aligned textured rectangle.
 struct SceneRect {
   int axis = 2;                 // 0, 1, 2: the plane's normal axis
   double offset = 0.0;          // the plane: x[axis] = offset
   int facing = 1;               // +1: visible from x[axis] > offset; -1: from below
   std::array<double, 2> lo{};   // bounds on axes (axis+1)%3 and (axis+2)%3
+  // Upper bounds on the two in-plane axes.
   std::array<double, 2> hi{};
   int texture = 0;              // index into Scene::textures()
   double texelSize = 0.006;     // metres per level-0 texel
 };
 
+// Where a ray hits the scene.
 struct SceneHit {
   double distance = 0.0;        // ray parameter t: hit = origin + t * direction
+  // Index of the rectangle hit.
   int rect = -1;
   Eigen::Vector2d texel;        // level-0 texture coordinates of the hit
 };
 
+// A scene of textured rectangles.
 class Scene {
  public:
+  // Adds a texture; returns its index.
   int addTexture(Texture texture);
   // Returns the rectangle's index. Throws std::invalid_argument for a bad axis, facing,
   // texture index or an empty extent (programming errors, not outside input).
@@ -49,9 +55,12 @@ class Scene {
   // from makeCornerTexture(seed + face).
   void addBox(const Eigen::Vector3d& min, const Eigen::Vector3d& max, double texelSize, std::uint64_t seed);
 
+  // @{
+  // The rectangles, a texture, and the number of textures.
   const std::vector<SceneRect>& rects() const { return rects_; }
   const Texture& texture(int i) const { return textures_[static_cast<std::size_t>(i)]; }
   std::size_t textureCount() const { return textures_.size(); }
+  // @}
 
   // World point of rectangle `rect` at level-0 texture coordinates (s, t).
   Eigen::Vector3d pointAt(int rect, double s, double t) const;
@@ -65,8 +74,10 @@ class Scene {
   std::vector<Texture> textures_;
 };
 
+// The rendered room: its extent, boxes and optional central block.
 struct RoomParams {
   Eigen::Vector3d min{-5.0, -4.0, 0.0};  // room interior, metres
+  // Upper corner of the room interior, metres.
   Eigen::Vector3d max{5.0, 4.0, 3.0};
   double texelSize = 0.006;              // metres per texel on every face
   int boxes = 8;                         // boxes around the centre, at several depths
@@ -78,6 +89,7 @@ struct RoomParams {
   Eigen::Vector2d pillarHalf{0.0, 0.0};
 };
 
+// Builds the room, every texture drawn from seed.
 Scene makeRoomScene(const RoomParams& params, std::uint64_t seed);
 
 }  // namespace orbis::synth

@@ -17,16 +17,20 @@
 
 namespace orbis::synth {
 
+// A grey texture with its mip levels.
 class Texture {
  public:
   Texture() = default;
   // image: CV_32FC1 (any other depth is converted); dimensions need not be powers of two.
   explicit Texture(const cv::Mat& image);
 
+  // @{
+  // Size of level 0, number of levels, and one level.
   int width() const { return levels_.empty() ? 0 : levels_[0].cols; }
   int height() const { return levels_.empty() ? 0 : levels_[0].rows; }
   int levelCount() const { return static_cast<int>(levels_.size()); }
   const cv::Mat& level(int l) const { return levels_[static_cast<std::size_t>(l)]; }
+  // @}
 
   // Trilinear sample at level-0 texture coordinates (x, y); lod = log2(texels per sample).
   float sample(double x, double y, double lod) const {
@@ -40,6 +44,7 @@ class Texture {
     return a + f * (b - a);
   }
 
+  // Bilinear sample of level l at level-0 coordinates (x, y).
   float bilinear(int l, double x, double y) const {
     const cv::Mat& m = levels_[static_cast<std::size_t>(l)];
     const double s = scale_[static_cast<std::size_t>(l)];
@@ -62,6 +67,7 @@ class Texture {
   std::vector<double> scale_;  // level size / level-0 size, per axis (exact powers of 1/2)
 };
 
+// The random corner-rich textures of the rendered scenes: nested rectangles over many scales.
 struct CornerTextureParams {
   int smallestLeaf = 5;     // texels: edge of the smallest rectangles
   int largestLeaf = 240;    // texels: edge of the largest rectangles

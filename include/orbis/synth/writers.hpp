@@ -25,21 +25,28 @@
 
 namespace orbis::synth {
 
+// The dataset layout a rendered sequence is written in.
 enum class SynthLayout { Tum, Euroc, Kitti };
 
 // "tum", "euroc" or "kitti"; anything else throws orbis::Error(source).
 SynthLayout parseSynthLayout(std::string_view name, const std::string& source = "layout");
+// "tum", "euroc" or "kitti".
 std::string_view toString(SynthLayout layout);
 
+// What writeSynthSequence wrote.
 struct SynthWriteResult {
   std::filesystem::path root;          // the layout's root (outDir)
   std::filesystem::path groundTruth;   // the ground-truth trajectory file
   std::filesystem::path settings;      // settings.yaml
   std::filesystem::path settingsMono;  // settings_mono.yaml
+  // @{
+  // Frames written, and how many of them black.
   int frames = 0;
   int blackFrames = 0;
+  // @}
   double renderSeconds = 0.0;          // wall time spent rendering (not writing)
   double renderCpuSeconds = 0.0;       // CPU time of the same, summed over threads
+  // Wall time of the whole write.
   double totalSeconds = 0.0;
 };
 

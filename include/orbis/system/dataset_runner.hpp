@@ -3,8 +3,9 @@
 // Contract: runDataset reads the sequence frame by frame through a DatasetReader, picks the
 // compile-time sensor configuration once from the dataset's sensor (Slam<Stereo>, Slam<Rgbd> or
 // Slam<Monocular>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
-// camera-to-world, every tracked frame), keyframes.txt (TUM), report.json (frame counts,
-// keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE of all frames and
+// camera-to-world, every tracked frame), trajectory_maps.txt (per line of it: timestamp, the
+// map it was tracked in, the map holding it now), keyframes.txt (TUM), report.json (frame counts,
+// keyframes, map points, the atlas's maps and merges, per-stage timing in ms: mean/median/p95, and the ATE of all frames and
 // of the keyframes when the dataset has ground truth, Sim(3)-aligned for monocular, else SE(3)), map.ply (map points) and overview.png (top view); for RGB-D, optionally a
 // dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
 // A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
@@ -29,43 +30,79 @@
 
 namespace orbis {
 
+// What orbis run does, as options of runDataset.
 struct RunOptions {
+  // ORB-SLAM2 settings file (empty: the dataset's calibration).
   std::optional<std::filesystem::path> settings;
+  // Vocabulary file (defaultVocabularyPath(): the shipped one).
   std::filesystem::path vocabulary;
+  // Output folder.
   std::filesystem::path outDir = "out";
+  // Run the stages inline in a fixed order (bit-identical runs).
   bool deterministic = false;
+  // Localisation only: no keyframes or points are added.
   bool localisationOnly = false;
+  // Whether loops are closed.
   bool loopClosing = true;
   std::optional<std::filesystem::path> denseCloud;  // RGB-D: back-projected keyframe depth maps
   std::size_t maxFrames = 0;                        // 0: all
+  // Show a progress bar on a terminal.
   bool progress = true;
   bool realtime = false;  // feed each frame at its timestamp (relative to the first), not as fast as tracking goes
   std::optional<std::filesystem::path> loadMap;  // map file to localise in (io/map_file.hpp)
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
   SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned
   bool stats = false;  // diagnosis: outDir/stats.jsonl, one line per frame and per keyframe (StageTimer events)
+  // @{
+  // The atlas (docs/guide/atlas.md): off keeps ORB-SLAM2's single map; when to open a new map.
+  bool atlas = true;
+  int newMapAfterLostFrames = 10;
+  double newMapAfterLostSeconds = 0.3;
+  // @}
 };
 
+// What a run did: its counters, timing, accuracy and warnings (report.json).
 struct RunReport {
+  // @{
+  // The sequence folder and the sensor it ran as.
   std::string dataset, sensor;
+  // @}
+  // Frames, keyframes, points and initialisation.
   SlamStats stats;
+  // Per-stage timing.
   std::vector<StageStats> timing;
   std::optional<double> ateRmse;  // of every tracked frame: metres (monocular: ground-truth units)
+  // Poses matched for the ATE.
   std::size_t ateMatched = 0;
   std::string ateAlignment = "se3";         // "sim3" for monocular: its map's scale is arbitrary
   std::optional<double> ateKeyFramesRmse;   // the same for the keyframe trajectory
+  // Keyframes matched for the keyframe ATE.
   std::size_t ateKeyFramesMatched = 0;
   double pathLength = 0;          // of the ground truth over the matched poses, metres
+  // Warnings, in order.
   std::vector<std::string> warnings;
+  // Wall time, seconds.
   double seconds = 0;
   std::size_t keyFramesLoaded = 0;  // from RunOptions::loadMap
   std::optional<bool> loadedMapMetricScale;  // from its file; false: the map's unit is arbitrary
   std::size_t densePoints = 0;      // voxels in RunOptions::denseCloud
+  // @{
+  // Relocalisation attempts and successes.
   std::size_t relocalisationAttempts = 0, relocalisations = 0;
+  // @}
   // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.
   std::vector<LoopClosureEvent> loopClosures;
+  // @{
+  // The atlas: every map opened (report.json "maps"), the merges in order, and per tracked frame
+  // the map it was tracked in (trajectory_maps.txt).
+  std::vector<AtlasMapInfo> maps;
+  std::vector<MapMergeEvent> merges;
+  std::vector<std::uint32_t> frameMaps;
+  // @}
 };
 
+// Runs SLAM over the whole sequence and writes trajectory.txt, keyframes.txt, report.json, map.ply
+// and overview.png into options.outDir (and stats.jsonl, the dense cloud and the map when asked).
 RunReport runDataset(DatasetReader& dataset, const RunOptions& options);
 
 // The vocabulary shipped with orbis: the source tree's vocabulary/ when run from a build, else

@@ -1,8 +1,9 @@
 // orbis/system/slam.hpp — the SLAM system a user instantiates: orbis::Slam<Sensor>.
 //
 // Contract: Slam<Sensor> turns each input into features with the sensor's compile-time
-// FeatureBuilder, then hands them to SlamCore<Sensor> (tracking, local mapping, loop closing over
-// one Map, every stage templated on the same sensor). track() returns the frame's pose and
+// FeatureBuilder, then hands them to SlamCore<PipelineSensor<Sensor>> (tracking, local mapping,
+// loop closing over one Map, every stage templated on the same sensor: Sensor itself, or the one
+// it names as its PipelineSensor, as MonocularFisheye names Monocular). track() returns the frame's pose and
 // tracking state. Two modes: threaded (real time: local mapping and loop closing run on their
 // own threads) and
 // deterministic (the same stages run inline in a fixed order after each frame, so the same
@@ -15,28 +16,37 @@
 #include <memory>
 #include <vector>
 
+#include "orbis/sensor/pipeline_sensor.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/system/slam_core.hpp"
 #include "orbis/util/timing.hpp"
 
 namespace orbis {
 
+// The SLAM system on a sensor: features by Sensor::FeatureBuilder, then SlamCore (tracking, local
+// mapping, loop closing).
 template <SensorConfiguration Sensor>
 class Slam {
  public:
+  // @{
+  // The sensor's camera model and input.
   using Camera = typename Sensor::Camera;
   using Input = typename Sensor::Input;
+  // @}
 
+  // A system for camera, with the extractor's parameters and the vocabulary.
   Slam(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
        SlamOptions options = {})
       : builder_(camera, orb), core_(camera, std::move(vocabulary), options) {}
-  // A monocular camera whose images still carry lens distortion (the builder undistorts keypoints).
-  Slam(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
-       std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options = {})
-    requires std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&,
-                                     const RadTanDistortion<double>&>
+  // A monocular camera whose images still carry lens distortion (the builder undistorts keypoints):
+  // RadTanDistortion for Monocular, the KannalaBrandtCamera for MonocularFisheye.
+  template <class Lens>
+  Slam(const Camera& camera, const OrbParams& orb, const Lens& lens, std::shared_ptr<const OrbVocabulary> vocabulary,
+       SlamOptions options = {})
+    requires std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&, const Lens&>
       : builder_(camera, orb, lens), core_(camera, std::move(vocabulary), options) {}
 
+  // Extracts the input's features and tracks them; returns the state and, when tracked, the pose.
   TrackResult track(const Input& input) {
     std::shared_ptr<const FrameFeatures> features;
     double extractionMs = 0;
@@ -55,19 +65,32 @@ class Slam {
     return result;
   }
 
+  // Finishes queued mapping and loop-closing work and joins the threads; the results stay readable.
   void shutdown() { core_.shutdown(); }
+  // Every tracked frame's pose (camera to world).
   Trajectory trajectory() const { return core_.trajectory(); }
+  // Every good keyframe's pose (camera to world).
   Trajectory keyFrameTrajectory() const { return core_.keyFrameTrajectory(); }
+  // The map's points.
   std::vector<Eigen::Vector3f> mapPointCloud() const { return core_.mapPointCloud(); }
+  // Frames, tracked, lost, keyframes, points, loops and initialisation.
   SlamStats stats() const { return core_.stats(); }
+  // The state after the last frame.
   TrackingState state() const { return core_.state(); }
+  // Switches localisation-only mode on or off.
   void setLocalisationOnly(bool on) { core_.setLocalisationOnly(on); }
   // See SlamCore::setFrameObserver and mapSnapshot (slam_observer.hpp).
   void setFrameObserver(FrameObserver observer) { core_.setFrameObserver(std::move(observer)); }
+  // A copy of the map, loops and trajectory (any thread).
   MapSnapshot mapSnapshot() const { return core_.mapSnapshot(); }
+  // Per-stage timing.
   const StageTimer& timer() const { return core_.timer(); }
-  SlamCore<Sensor>& core() { return core_; }
-  const SlamCore<Sensor>& core() const { return core_; }
+  // @{
+  // The core, for what Slam does not forward (map files, the map itself): its pipeline sensor's.
+  using Core = SlamCore<PipelineSensor<Sensor>>;
+  Core& core() { return core_; }
+  const Core& core() const { return core_; }
+  // @}
 
  private:
   // The image a frame observer is shown: the left one of a stereo pair.
@@ -77,7 +100,7 @@ class Slam {
   }
 
   typename Sensor::FeatureBuilder builder_;
-  SlamCore<Sensor> core_;
+  SlamCore<PipelineSensor<Sensor>> core_;
 };
 
 }  // namespace orbis

@@ -32,9 +32,11 @@
 
 namespace orbis {
 
+// How the system runs.
 struct SlamOptions {
   bool deterministic = false;     // inline stages in a fixed order (the tests use it)
   bool localisationOnly = false;  // tracking only, against the existing map (§III-F)
+  // Whether loops are closed.
   bool loopClosing = true;
   double fps = 30;                // frame rate: the keyframe rule's "max frames" (ORB-SLAM2)
   // Frames come from a live camera at fps (orbis run --realtime): threaded monocular tracking
@@ -43,15 +45,34 @@ struct SlamOptions {
   // until mapping is idle, which costs wall time but no frames.
   bool liveCamera = false;
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
+  // @{
+  // The atlas (issue 32; docs/guide/atlas.md): a new map when relocalisation has failed on
+  // newMapAfterLostFrames frames that could start one, over newMapAfterLostSeconds; maps merged
+  // when loop closing recognises a place of another. Off: ORB-SLAM2's single map.
+  bool atlas = true;
+  int newMapAfterLostFrames = 10;
+  double newMapAfterLostSeconds = 0.3;
+  // @}
 };
 
+// What a run has done so far.
 struct SlamStats {
+  // @{
+  // Frames seen, tracked and lost; keyframes and map points in the map.
   std::size_t frames = 0, tracked = 0, lost = 0, keyFrames = 0, mapPoints = 0;
+  // @}
+  // Loops closed.
   std::size_t loopClosures = 0;
+  // @{
   // The frame the map started on (monocular: the second view of the accepted pair), and why the
   // frames before it did not start it (Tracker::initialisationWaits: reason -> frames).
   std::optional<std::uint64_t> initialisedAtFrame;
   std::map<std::string, std::size_t> initialisationWaits;
+  // @}
+  // @{
+  // Maps ever opened in the atlas, and merges done.
+  std::size_t maps = 1, mapMerges = 0;  // maps ever opened in the atlas, merges done
+  // @}
 };
 
 // Everything after feature extraction: tracking, local mapping, loop closing and relocalisation
@@ -59,8 +80,10 @@ struct SlamStats {
 template <SensorConfiguration Sensor>
 class SlamCore {
  public:
+  // The sensor's camera model.
   using Camera = typename Sensor::Camera;
 
+  // A core for camera with the vocabulary; starts the threads unless deterministic.
   SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options);
   ~SlamCore();
   SlamCore(const SlamCore&) = delete;
@@ -70,17 +93,31 @@ class SlamCore {
   // frame observer, if one is set.
   TrackResult track(std::shared_ptr<const FrameFeatures> features, double timestamp, double extractionMs = 0,
                     const cv::Mat& image = cv::Mat());
+  // Finishes queued work and joins the threads; the results stay readable.
   void shutdown();
 
   Trajectory trajectory() const;          // every tracked frame, camera-to-world
+  // Per frame of trajectory(): the map it was tracked in, and the map holding it now (they
+  // differ once its map was merged into another; then its pose is in that map's frame).
+  std::vector<std::uint32_t> trajectoryMaps(bool current = false) const;
+  // @{
+  // The atlas: every map ever opened (merged ones flagged), the active one, the merges so far.
+  std::vector<AtlasMapInfo> maps() const;
+  std::uint32_t activeMapId() const;
+  std::vector<MapMergeEvent> merges() const;
+  // @}
   Trajectory keyFrameTrajectory() const;  // every good keyframe, camera-to-world
+  // @{
+  // The map's points, the counters, the tracking state, and localisation-only mode.
   std::vector<Eigen::Vector3f> mapPointCloud() const;
   SlamStats stats() const;
   TrackingState state() const { return tracker_->state(); }
   void setLocalisationOnly(bool on);
+  // @}
   // Called after every frame on the tracking thread (slam_observer.hpp); set before tracking
   // starts, empty to remove. Without one, track() does no extra work.
   void setFrameObserver(FrameObserver observer);
+  // Whether a frame observer is set.
   bool observesFrames() const { return static_cast<bool>(frameObserver_); }
   // The map, loop closures and trajectory copied under the map mutex; callable from any thread.
   MapSnapshot mapSnapshot() const;
@@ -90,17 +127,23 @@ class SlamCore {
   // The file records whether the map's scale is metric (Sensor::kMetricScale); loadMap returns
   // the file's header.
   void saveMap(const std::filesystem::path& file);
+  // Loads a map file into a core that has not tracked yet; returns the file's header.
   MapFileInfo loadMap(const std::filesystem::path& file);
+  // The sensor's kind.
   static constexpr SensorKind sensorKind() { return Sensor::kKind; }
   // Relocalisation attempts and successes; keyframes loaded from a map file.
   RelocalisationStats relocalisationStats() const;
+  // Keyframes loaded from a map file.
   std::size_t loadedKeyFrames() const { return loadedKeyFrames_; }
 
+  // @{
+  // The map, the timer and the camera.
   Map& map() { return map_; }
   const Map& map() const { return map_; }
   StageTimer& timer() { return timer_; }
   const StageTimer& timer() const { return timer_; }
   const Camera& camera() const { return camera_; }
+  // @}
   // What the map file records of the camera.
   const MapIntrinsics& intrinsics() const { return intrinsics_; }
   // Null when loop closing is off (SlamOptions::loopClosing, localisation-only mode).

@@ -22,6 +22,7 @@ SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabu
     LoopCloserOptions loopOptions;
     loopOptions.threaded = !options_.deterministic;
     loopOptions.seed = options_.seed;
+    loopOptions.mergeMaps = options_.atlas;
     loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);
   }
   // Processed keyframes feed the keyframe database: through the loop closer (which queries it
@@ -36,12 +37,20 @@ SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabu
   TrackerOptions trackerOptions;
   trackerOptions.maxFramesBetweenKeyFrames = std::max(1, static_cast<int>(options_.fps + 0.5));
   trackerOptions.localisationOnly = options_.localisationOnly;
+  trackerOptions.atlas = options_.atlas;
+  trackerOptions.newMapAfterLostFrames = options_.newMapAfterLostFrames;
+  trackerOptions.newMapAfterLostSeconds = options_.newMapAfterLostSeconds;
   tracker_ = std::make_unique<Tracker<Sensor>>(map_, *vocabulary_, mapper_.get(), trackerOptions, &timer_);
   RelocaliserOptions relocaliserOptions;
   relocaliserOptions.seed = options_.seed;
   relocaliser_ = std::make_unique<Relocaliser<Sensor>>(map_, database_, relocaliserOptions);
-  // Called by the tracker, map mutex held, when it is lost.
-  tracker_->setRelocaliser([this](Frame<Camera>& frame) { return relocaliser_->relocalise(frame); });
+  // Called by the tracker, map mutex held, when it is lost. The database spans the atlas: found
+  // in another map, tracking goes on there (that map becomes the active one).
+  tracker_->setRelocaliser([this](Frame<Camera>& frame) {
+    if (!relocaliser_->relocalise(frame)) return false;
+    if (const KeyFrame* kf = map_.keyFrame(relocaliser_->stats().lastKeyFrame)) map_.setActiveMap(kf->mapId());
+    return true;
+  });
 }
 
 template <SensorConfiguration Sensor>
@@ -137,7 +146,10 @@ MapSnapshot SlamCore<Sensor>::mapSnapshot() const {
       snapshot.trajectory.push_back(worldPoseOf(f).inverse().translation().cast<float>());
     snapshot.frames = frames_;
   }
-  if (loopCloser_) snapshot.loopClosures = loopCloser_->closures();
+  if (loopCloser_) {
+    snapshot.loopClosures = loopCloser_->closures();
+    snapshot.merges = loopCloser_->merges();
+  }
   return snapshot;
 }
 
@@ -163,7 +175,8 @@ RelocalisationStats SlamCore<Sensor>::relocalisationStats() const {
 // wall time (teddy monocular: 11 s for 6.7 s of frames on two cores, 7 s without), so with a live
 // camera (SlamOptions::liveCamera) tracking keeps the camera's rate instead: mapping gets what is
 // left of the frame period (1/fps after extraction and tracking), and tracking runs on if it has
-// not finished. The metric sensors need no wait: each frame measures its own depth.
+// not finished. The metric sensors need no wait: each frame measures its own depth. Measurements:
+// docs/notes/2026-11-24-monocular-threaded-wait.md.
 template <SensorConfiguration Sensor>
 void SlamCore<Sensor>::waitForMappingAfterKeyFrame(std::chrono::steady_clock::time_point trackingStart,
                                                    double extractionMs) {
@@ -218,6 +231,46 @@ Trajectory SlamCore<Sensor>::trajectory() const {
 }
 
 template <SensorConfiguration Sensor>
+std::vector<std::uint32_t> SlamCore<Sensor>::trajectoryMaps(bool current) const {
+  std::lock_guard lock(map_.mutex());
+  std::vector<std::uint32_t> out;
+  out.reserve(tracker_->trackedFrames().size());
+  for (const TrackedFrame& f : tracker_->trackedFrames()) out.push_back(current ? f.reference->mapId() : f.mapId);
+  return out;
+}
+
+template <SensorConfiguration Sensor>
+std::vector<AtlasMapInfo> SlamCore<Sensor>::maps() const {
+  std::lock_guard lock(map_.mutex());
+  std::vector<AtlasMapInfo> out;
+  for (const AtlasMapRecord& r : map_.mapRecords()) {
+    AtlasMapInfo info;
+    info.id = r.id;
+    info.startFrame = r.startFrame;
+    info.active = r.id == map_.activeMapId();
+    info.merged = r.mergedInto.has_value();
+    info.mergedInto = r.mergedInto.value_or(r.id);
+    if (!info.merged) {
+      info.keyFrames = map_.keyFrameCount(r.id);
+      info.mapPoints = map_.mapPointCount(r.id);
+    }
+    out.push_back(info);
+  }
+  return out;
+}
+
+template <SensorConfiguration Sensor>
+std::uint32_t SlamCore<Sensor>::activeMapId() const {
+  std::lock_guard lock(map_.mutex());
+  return map_.activeMapId();
+}
+
+template <SensorConfiguration Sensor>
+std::vector<MapMergeEvent> SlamCore<Sensor>::merges() const {
+  return loopCloser_ ? loopCloser_->merges() : std::vector<MapMergeEvent>{};
+}
+
+template <SensorConfiguration Sensor>
 Trajectory SlamCore<Sensor>::keyFrameTrajectory() const {
   std::lock_guard lock(map_.mutex());
   Trajectory out;
@@ -245,6 +298,8 @@ SlamStats SlamCore<Sensor>::stats() const {
   s.loopClosures = loopCloser_ ? loopCloser_->closures().size() : 0;
   s.initialisedAtFrame = initialisedAtFrame_;
   s.initialisationWaits = tracker_->initialisationWaits();
+  s.maps = map_.mapRecords().size();
+  s.mapMerges = loopCloser_ ? loopCloser_->merges().size() : 0;
   return s;
 }
 

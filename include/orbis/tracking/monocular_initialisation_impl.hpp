@@ -185,11 +185,11 @@ void Tracker<Sensor>::startMap(KeyFrame* first, KeyFrame* second, FrameT& f)
   first->updateConnections();
   second->updateConnections();
   // The reference frame is tracked too: it is the first keyframe, at the origin.
-  tracked_.push_back({first->frameIndex, first->timestamp, first, SE3d()});
+  tracked_.push_back({first->frameIndex, first->timestamp, first, SE3d(), first->mapId()});
   reference_ = second;
   lastKeyFrameFrame_ = f.index;
   localKeyFrames_ = {second, first};
-  localPoints_ = map_.mapPoints();
+  localPoints_ = map_.mapPoints(map_.activeMapId());
   matchesInliers_ = static_cast<int>(localPoints_.size());
   initialReference_.reset();
   if (mapper_) {

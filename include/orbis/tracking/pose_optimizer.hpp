@@ -16,6 +16,8 @@
 
 namespace orbis {
 
+// Motion-only BA of a frame against its matched map points (ORB-SLAM2's PoseOptimization); marks
+// outliers and returns the inliers.
 template <optim::RobustKernel Kernel = optim::HuberKernel, CameraModel Camera>
 int optimizePose(Frame<Camera>& frame) {
   const FrameFeatures& f = *frame.features;

@@ -36,22 +36,35 @@
 
 namespace orbis {
 
+// @{
+// Eigen-aligned vectors of points and pixels.
 using Vector3dList = std::vector<Eigen::Vector3d, Eigen::aligned_allocator<Eigen::Vector3d>>;
 using Vector2dList = std::vector<Eigen::Vector2d, Eigen::aligned_allocator<Eigen::Vector2d>>;
+// @}
 
+// EPnP: the pose of a camera from 3-D world points and their pixels; false when degenerate.
 bool solveEpnp(const Vector3dList& world, const Vector2dList& pixels, const PinholeCamera<double>& K, SE3d& Tcw);
 
+// The relocaliser's PnP RANSAC.
 struct PnpRansacParams {
+  // @{
+  // Confidence, inliers required and the iteration cap.
   double probability = 0.99;
   int minInliers = 10;
   int maxIterations = 300;
+  // @}
   double chi2 = 5.991;  // 2-dof, 95%
 };
 
+// A PnP RANSAC result.
 struct PnpRansacResult {
+  // @{
+  // Whether a pose was found, and the pose.
   bool found = false;
   SE3d Tcw;
+  // @}
   std::vector<char> inlier;  // per correspondence
+  // Correspondences agreeing with it.
   int inliers = 0;
 };
 
@@ -60,29 +73,44 @@ PnpRansacResult solvePnpRansac(const Vector3dList& world, const Vector2dList& pi
                                const std::vector<float>& sigma2, const PinholeCamera<double>& K,
                                const PnpRansacParams& params, std::mt19937_64& rng);
 
+// Relocalisation thresholds (ORB-SLAM2's).
 struct RelocaliserOptions {
+  // @{
+  // Bag-of-words ratio, matches a candidate needs, inliers to accept, RANSAC seed and settings.
   float bowRatio = 0.75f;
   int minBowMatches = 15;
   int acceptInliers = 50;
   std::uint64_t seed = 0;
   PnpRansacParams ransac;
+  // @}
 };
 
+// Relocalisation counters.
 struct RelocalisationStats {
+  // @{
+  // Attempts and successes.
   std::size_t attempts = 0, successes = 0;
+  // @}
+  // Candidates of the last attempt.
   std::size_t lastCandidates = 0;
   KeyFrameId lastKeyFrame = 0;  // the keyframe the last success matched
 };
 
+// Relocalisation (§III-F): keyframe candidates by bag of words, PnP RANSAC, then guided search and
+// motion-only BA over the candidate's neighbourhood.
 template <SensorConfiguration Sensor>
 class Relocaliser {
  public:
+  // The sensor's frame type.
   using FrameT = Frame<typename Sensor::Camera>;
 
+  // Relocalises in map through the keyframe database.
   Relocaliser(const Map& map, const bow::KeyframeDatabase& database, RelocaliserOptions options = {})
       : map_(map), database_(database), options_(options) {}
 
+  // Sets the frame's pose and matches when it finds itself in the map again.
   bool relocalise(FrameT& frame);
+  // Attempts and successes so far.
   const RelocalisationStats& stats() const { return stats_; }
 
  private:

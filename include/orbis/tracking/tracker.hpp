@@ -41,10 +41,12 @@ namespace orbis {
 
 
 
+// Tracking's thresholds (ORB-SLAM2's unless noted).
 struct TrackerOptions {
   int closeTrackedThreshold = 100;   // τt: fewer tracked close points than this …
   int closeCreatableThreshold = 70;  // τc: … and at least this many creatable ones → keyframe
   int maxFramesBetweenKeyFrames = 30;  // the camera's fps, as ORB-SLAM2
+  // Frames a new keyframe must wait after the last (0: none).
   int minFramesBetweenKeyFrames = 0;
   int minBootstrapFeatures = 500;      // keypoints needed to start the map (ORB-SLAM2)
   int bowLevelsUp = 4;                 // vocabulary level of the FeatureVector grouping
@@ -54,38 +56,64 @@ struct TrackerOptions {
   int minInitialisationMatches = 100;    // windowed matches below this drop the reference
   float initialisationWindow = 100;      // px around the previous match (ORB-SLAM's)
   unsigned initialisationSeed = 5489;    // the two-view RANSAC's generator (deterministic runs)
+  // @{
+  // The atlas (issue 32): when relocalisation has failed on at least newMapAfterLostFrames frames
+  // that could start a map, spanning at least newMapAfterLostSeconds, a new map is opened (the
+  // old ones stay): at once for metric sensors, by two-view initialisation for monocular. Off:
+  // ORB-SLAM2's single map, lost until relocalised.
+  bool atlas = true;
+  int newMapAfterLostFrames = 10;
+  double newMapAfterLostSeconds = 0.3;
+  // @}
 };
 
+// What tracking made of a frame.
 struct TrackResult {
+  // Ok, Lost or NotInitialised.
   TrackingState state = TrackingState::NotInitialised;
   SE3d Tcw;              // valid when state == Ok
   int inliers = 0;       // matches to map points after motion-only BA
+  // Whether the frame became a keyframe.
   bool newKeyFrame = false;
+  bool newMap = false;   // the frame opened a new map of the atlas (after a loss)
+  std::uint32_t mapId = 0;  // the map of the atlas it was tracked in
 };
 
 
 // A tracked frame, stored relative to its reference keyframe.
 struct TrackedFrame {
+  // @{
+  // Frame index, seconds and the reference keyframe.
   std::uint64_t index;
   double timestamp;
   KeyFrame* reference;
+  // @}
   SE3d Tcr;  // camera-from-reference-keyframe
+  std::uint32_t mapId = 0;  // the map of the atlas it was tracked in (its reference's map moves on merges)
 };
 
 // Camera-from-world of a tracked frame through its (possibly since culled) reference keyframe.
 SE3d worldPoseOf(const TrackedFrame& f);
 
+// Tracking (§III-B/§V): motion model or reference keyframe, then the local map; decides keyframes
+// and relocalises when lost.
 template <SensorConfiguration Sensor>
 class Tracker {
  public:
+  // @{
+  // The sensor's camera model and frame type.
   using Camera = typename Sensor::Camera;
   using FrameT = Frame<Camera>;
+  // @}
 
+  // Tracks against map, handing keyframes to mapper.
   Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMappingControl* mapper, TrackerOptions options,
           StageTimer* timer = nullptr);
 
+  // Tracks one frame.
   TrackResult track(FrameT frame);
 
+  // The state after the last frame.
   TrackingState state() const { return state_; }
   // Why the last monocular initialisation attempt was refused (None before any attempt).
   TwoViewRefusal initialisationRefusal() const { return initialisationRefusal_; }
@@ -93,10 +121,14 @@ class Tracker {
   // reasons: "too few keypoints" (no reference frame: a textureless or blank view), "new
   // reference frame", or a TwoViewRefusal's name ("too few matches", "low parallax", ...).
   const std::map<std::string, std::size_t>& initialisationWaits() const { return initialisationWaits_; }
+  // @{
+  // Localisation-only mode (no keyframes).
   void setLocalisationOnly(bool on) { options_.localisationOnly = on; }
   bool localisationOnly() const { return options_.localisationOnly; }
+  // @}
   // Every tracked frame, by index. Read with the map mutex held (poses move with the map).
   const std::vector<TrackedFrame>& trackedFrames() const { return tracked_; }
+  // World pose of a tracked frame.
   static SE3d worldPose(const TrackedFrame& f) { return worldPoseOf(f); }
   // Relocalisation hook (loop module): given the frame, returns true and sets its pose/matches
   // when it found itself in the map again.
@@ -107,6 +139,7 @@ class Tracker {
   void setRecordKeypointStates(bool on) { recordKeypointStates_ = on; }
   // The last frame's keypoint states (empty unless recording) and its local map. Tracking thread.
   const std::vector<KeypointState>& keypointStates() const { return keypointStates_; }
+  // The last frame's local map.
   const std::vector<MapPoint*>& localMapPoints() const { return localPoints_; }
 
  private:
@@ -122,6 +155,10 @@ class Tracker {
     requires(!Sensor::kMetricScale);
   void startMap(KeyFrame* first, KeyFrame* second, FrameT& f)
     requires(!Sensor::kMetricScale);
+  // The atlas: counts a lost frame that could start a map; true when a new map is due.
+  bool newMapDue();
+  // Opens a new map after a loss and starts it from `f` where the sensor can (metric: at once).
+  bool startNewMapAfterLoss(FrameT& f);
   bool trackReferenceKeyFrame();
   // Projects the last frame's matches through `motion` (current from last) and optimises.
   bool trackWithMotionModel(const SE3d& motion);
@@ -167,6 +204,9 @@ class Tracker {
   std::vector<KeypointState> keypointStates_;
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;
   std::vector<TrackedFrame> tracked_;
+  int lostFramesWithView_ = 0;  // lost frames since the last tracked one that could start a map
+  double lostSince_ = 0;        // timestamp of the first of them
+  std::uint64_t mergesSeen_ = 0;  // Map::mergeCount() when the last frame was tracked
   mutable std::vector<std::pair<std::string, double>> diagnostics_;
 
   // Monocular initialisation: the reference frame, where its keypoints were last matched.

@@ -94,6 +94,8 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
       ScopedStage stage(timer_, "tracking: pose prediction");
       if (state_ == TrackingState::Ok) {
         replaceRetiredPoints(last_);
+        // A merge moved the map since the last frame: its pose, re-read through its reference.
+        if (map_.mergeCount() != mergesSeen_ && !tracked_.empty()) last_.Tcw = worldPose(tracked_.back());
         // After a loop closure the velocity is still valid but the last pose moved: ORB-SLAM
         // re-reads it from its reference keyframe (updateLastFrame).
         if (withinFramesOfRelocalisation(2)) {
@@ -123,6 +125,11 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
       ok = trackLocalMap();
     }
     state_ = ok ? TrackingState::Ok : TrackingState::Lost;
+    if (ok) lostFramesWithView_ = 0;
+    else if (newMapDue() && startNewMapAfterLoss(current_)) {
+      result.newKeyFrame = result.newMap = true;
+      if (recordKeypointStates_) recordKeypointStates();
+    }
     if (ok && wasTracked) {
       velocity_ = current_.Tcw * last_.Tcw.inverse();
     } else {
@@ -155,7 +162,9 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
   if (state_ == TrackingState::Ok) {
     result.Tcw = current_.Tcw;
     result.inliers = matchesInliers_;
-    tracked_.push_back({current_.index, current_.timestamp, reference_, current_.Tcw * reference_->Tcw().inverse()});
+    result.mapId = reference_->mapId();
+    tracked_.push_back({current_.index, current_.timestamp, reference_, current_.Tcw * reference_->Tcw().inverse(),
+                        reference_->mapId()});
   }
   if (timer_ && timer_->eventsEnabled()) {
     int stereo = 0, close = 0;
@@ -172,6 +181,7 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
     timer_->event("frame", std::move(diagnostics_));
     diagnostics_.clear();
   }
+  mergesSeen_ = map_.mergeCount();
   if (state_ != TrackingState::NotInitialised) last_ = std::move(current_);  // current_ is refilled next frame
   return result;
 }
@@ -201,10 +211,43 @@ bool Tracker<Sensor>::bootstrap(FrameT& f)
   reference_ = kf;
   lastKeyFrameFrame_ = f.index;
   localKeyFrames_ = {kf};
-  localPoints_ = map_.mapPoints();
+  localPoints_ = map_.mapPoints(map_.activeMapId());
   if (mapper_) mapper_->insertKeyFrame(kf);
   matchesInliers_ = static_cast<int>(localPoints_.size());
   return true;
+}
+
+template <SensorConfiguration Sensor>
+bool Tracker<Sensor>::newMapDue() {
+  if (!options_.atlas || options_.localisationOnly) return false;
+  // Only frames that could start a map count: a covered lens or a blank wall cannot, and the
+  // camera may still come back to the map when it sees again.
+  std::size_t needed = static_cast<std::size_t>(options_.minBootstrapFeatures);
+  if constexpr (!Sensor::kMetricScale) needed = static_cast<std::size_t>(options_.minInitialisationKeypoints);
+  if (current_.size() <= needed) return false;
+  if (lostFramesWithView_++ == 0) lostSince_ = current_.timestamp;
+  return lostFramesWithView_ >= options_.newMapAfterLostFrames &&
+         current_.timestamp - lostSince_ >= options_.newMapAfterLostSeconds;
+}
+
+template <SensorConfiguration Sensor>
+bool Tracker<Sensor>::startNewMapAfterLoss(FrameT& f) {
+  map_.startNewMap(f.index);
+  lostFramesWithView_ = 0;
+  velocity_.reset();
+  lastRelocalisedFrame_.reset();
+  f.resetMatches();
+  state_ = TrackingState::NotInitialised;
+  if constexpr (Sensor::kMetricScale) {
+    if (!bootstrap(f)) return false;
+    state_ = TrackingState::Ok;
+    return true;
+  } else {
+    // Monocular: this frame becomes the two-view reference; the map starts with a later one.
+    initialReference_.reset();
+    initialiseFromTwoViews(f);
+    return false;
+  }
 }
 
 template <SensorConfiguration Sensor>
@@ -414,7 +457,7 @@ template <SensorConfiguration Sensor>
 bool Tracker<Sensor>::needNewKeyFrame() const {
   if (options_.localisationOnly) return false;
   if (mapper_ && mapper_->isStoppedOrStopping()) return false;
-  const std::size_t keyFrames = map_.keyFrameCount();
+  const std::size_t keyFrames = map_.keyFrameCount(map_.activeMapId());
   const auto maxFrames = static_cast<std::uint64_t>(options_.maxFramesBetweenKeyFrames);
   // ORB-SLAM2 makes no keyframe for maxFrames (one second) after a relocalisation once the map
   // has more than maxFrames keyframes, so that a wrong relocalisation cannot spread into the map.

@@ -11,6 +11,8 @@
 
 namespace orbis {
 
+// Writes bytes to path through a temporary file in the same folder and a rename, so a reader never
+// sees half a file; throws orbis::Error naming the path.
 void writeFileAtomically(const std::filesystem::path& path, std::span<const char> bytes);
 
 }  // namespace orbis

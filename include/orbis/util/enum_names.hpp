@@ -18,12 +18,17 @@
 
 namespace orbis {
 
+// One row of an enum's name table: a value and its name.
 template <class Enum>
 struct EnumName {
+  // @{
+  // The value and the name it is written as.
   Enum value;
   std::string_view name;
+  // @}
 };
 
+// Whether names compare exactly or ignoring ASCII letter case.
 enum class LetterCase { Exact, Ignored };
 
 namespace enum_names_detail {
@@ -38,6 +43,7 @@ constexpr bool sameName(std::string_view a, std::string_view b, LetterCase lette
 }
 }  // namespace enum_names_detail
 
+// The value whose name is text, or nothing.
 template <class Enum, std::size_t N>
 constexpr std::optional<Enum> findEnumName(const EnumName<Enum> (&table)[N], std::string_view text,
                                            LetterCase letterCase = LetterCase::Exact) {
@@ -63,6 +69,7 @@ Enum parseEnumName(const EnumName<Enum> (&table)[N], std::string_view text, std:
               "unknown " + std::string(what) + " \"" + std::string(text) + "\" (expected " + expected + ")");
 }
 
+// The name of value in table (empty when it has none).
 template <class Enum, std::size_t N>
 constexpr std::string_view enumName(const EnumName<Enum> (&table)[N], Enum value) {
   for (const EnumName<Enum>& row : table) {

@@ -12,6 +12,8 @@
 
 namespace orbis {
 
+// The one exception orbis throws for bad input: what() reads "source: where: what", naming the
+// file, device or argument, and the key or line.
 class Error : public std::runtime_error {
  public:
   // source: file path or other origin ("settings", "argument --max-dt"); where: "line 12",
@@ -21,8 +23,11 @@ class Error : public std::runtime_error {
         source_(std::move(source)),
         where_(std::move(where)) {}
 
+  // @{
+  // The origin (file, device, argument) and the place in it (key or line; may be empty).
   const std::string& source() const noexcept { return source_; }
   const std::string& where() const noexcept { return where_; }
+  // @}
 
  private:
   static std::string compose(const std::string& source, const std::string& where,
@@ -36,10 +41,13 @@ class Error : public std::runtime_error {
   std::string where_;
 };
 
+// An error about a whole file.
 inline Error fileError(const std::string& path, const std::string& what) { return {path, "", what}; }
+// An error at a line of a file.
 inline Error lineError(const std::string& path, std::size_t line, const std::string& what) {
   return {path, "line " + std::to_string(line), what};
 }
+// An error about a key of a file.
 inline Error keyError(const std::string& path, const std::string& key, const std::string& what) {
   return {path, "key " + key, what};
 }

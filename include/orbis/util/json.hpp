@@ -13,13 +13,18 @@
 
 namespace orbis {
 
+// Builds one JSON value by appending objects, arrays, keys and values in order.
 class JsonWriter {
  public:
+  // @{
+  // Opens or closes an object or an array.
   JsonWriter& beginObject() { separate(); out_ += '{'; first_.push_back(true); return *this; }
   JsonWriter& endObject() { out_ += '}'; first_.pop_back(); return *this; }
   JsonWriter& beginArray() { separate(); out_ += '['; first_.push_back(true); return *this; }
   JsonWriter& endArray() { out_ += ']'; first_.pop_back(); return *this; }
+  // @}
 
+  // Writes an object's key; the next value is its value.
   JsonWriter& key(std::string_view k) {
     separate();
     writeString(k);
@@ -27,6 +32,8 @@ class JsonWriter {
     afterKey_ = true;
     return *this;
   }
+  // @{
+  // Writes a value (non-finite numbers as null).
   JsonWriter& value(double v) {
     separate();
     if (!std::isfinite(v)) { out_ += "null"; return *this; }
@@ -42,10 +49,13 @@ class JsonWriter {
   JsonWriter& value(std::string_view v) { separate(); writeString(v); return *this; }
   JsonWriter& value(const char* v) { return value(std::string_view(v)); }
   JsonWriter& null() { separate(); out_ += "null"; return *this; }
+  // @}
 
+  // Writes a key and its value.
   template <typename T>
   JsonWriter& field(std::string_view k, const T& v) { key(k); return value(v); }
 
+  // The JSON text so far.
   const std::string& str() const { return out_; }
 
  private:

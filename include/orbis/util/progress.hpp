@@ -12,8 +12,10 @@
 
 namespace orbis {
 
+// A progress bar on standard error, drawn only on a terminal and at most ten times a second.
 class ProgressBar {
  public:
+  // label: what is counted; total: how many items make 100 %; enabled false: never draws.
   ProgressBar(std::string label, std::size_t total, bool enabled = true)
       : label_(std::move(label)), total_(total),
         enabled_(enabled && ::isatty(::fileno(stderr)) != 0),
@@ -37,6 +39,7 @@ class ProgressBar {
     std::fflush(stderr);
     drawn_ = true;
   }
+  // Ends the bar's line (also done by the destructor).
   void finish() {
     if (enabled_ && drawn_) {
       std::fputc('\n', stderr);

@@ -22,6 +22,8 @@
 
 namespace orbis {
 
+// A queue of items served by one worker thread (or inline, when never started): local mapping's and
+// loop closing's queues.
 template <class Item>
 class QueueWorker {
  public:
@@ -30,6 +32,7 @@ class QueueWorker {
   QueueWorker& operator=(const QueueWorker&) = delete;
   ~QueueWorker() { stop(); }
 
+  // Starts the thread, which calls serve() whenever items are queued or it is woken.
   void start(std::function<void()> serve) {
     thread_ = std::thread([this, serve = std::move(serve)] {
       while (!finishing()) {
@@ -52,6 +55,7 @@ class QueueWorker {
     });
   }
 
+  // Queues an item and wakes the worker.
   void push(Item item) {
     {
       std::lock_guard lock(mutex_);
@@ -59,6 +63,7 @@ class QueueWorker {
     }
     cv_.notify_all();
   }
+  // Takes the oldest item, if any.
   std::optional<Item> pop() {
     std::lock_guard lock(mutex_);
     if (queue_.empty()) return std::nullopt;
@@ -66,6 +71,7 @@ class QueueWorker {
     queue_.pop_front();
     return item;
   }
+  // Items queued.
   std::size_t size() const {
     std::lock_guard lock(mutex_);
     return queue_.size();
@@ -73,10 +79,13 @@ class QueueWorker {
   // Wakes the worker to look at its flags again.
   void wake() { cv_.notify_all(); }
 
+  // Whether the worker runs on its own thread.
   bool threaded() const { return thread_.joinable(); }
+  // Whether serve() is running now.
   bool busy() const { return busy_.load(); }
   // Nothing queued and nothing being served.
   bool idle() const { return size() == 0 && !busy(); }
+  // Whether stop() was called.
   bool finishing() const { return finish_.load(); }
 
   // `alsoIdle` adds the owner's own condition (for instance no full BA running).
@@ -93,6 +102,7 @@ class QueueWorker {
     return waitIdleUntil(std::chrono::steady_clock::now() + budget, {});
   }
 
+  // Asks the thread to finish and joins it.
   void stop() {
     finish_ = true;
     cv_.notify_all();

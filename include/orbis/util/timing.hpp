@@ -18,32 +18,48 @@
 
 namespace orbis {
 
+// Statistics of one stage over a run, in milliseconds.
 struct StageStats {
+  // The stage's name, e.g. "tracking: ORB extraction".
   std::string stage;
+  // How many times it ran.
   std::size_t count = 0;
+  // @{
+  // Mean, median, 95th percentile and largest duration, ms.
   double meanMs = 0, medianMs = 0, p95Ms = 0, maxMs = 0;
+  // @}
 };
 
 // One logged event: what it is about ("frame", "keyframe") and its named values.
 struct StageEvent {
+  // @{
+  // What the event is about ("frame", "keyframe") and its counters by name.
   std::string kind;
   std::vector<std::pair<std::string, double>> values;
+  // @}
 };
 
+// Per-stage durations and, for diagnosis, per-frame and per-keyframe events; thread-safe.
 class StageTimer {
  public:
+  // @{
+  // Turns event logging on or off (orbis run --stats), and asks whether it is on.
   void enableEvents(bool on) { eventsOn_ = on; }
   bool eventsEnabled() const { return eventsOn_; }
+  // @}
+  // Logs an event when events are on.
   void event(std::string kind, std::vector<std::pair<std::string, double>> values) {
     if (!eventsOn_) return;
     std::lock_guard lock(mutex_);
     events_.push_back({std::move(kind), std::move(values)});
   }
+  // The events logged so far.
   std::vector<StageEvent> events() const {
     std::lock_guard lock(mutex_);
     return events_;
   }
 
+  // Records one duration of a stage, ms.
   void record(const std::string& stage, double ms) {
     std::lock_guard lock(mutex_);
     for (auto& [name, samples] : stages_)
@@ -51,6 +67,7 @@ class StageTimer {
     stages_.emplace_back(stage, std::vector<double>{ms});
   }
 
+  // Count, mean, median, p95 and max per stage, in the order stages were first recorded.
   std::vector<StageStats> summary() const {
     std::lock_guard lock(mutex_);
     std::vector<StageStats> out;
@@ -81,6 +98,7 @@ class StageTimer {
 // Measures the scope it lives in and records it into a StageTimer (or nowhere, if null).
 class ScopedStage {
  public:
+  // Starts measuring; the destructor records the time into timer under stage.
   ScopedStage(StageTimer* timer, std::string stage)
       : timer_(timer), stage_(std::move(stage)), start_(std::chrono::steady_clock::now()) {}
   ~ScopedStage() {

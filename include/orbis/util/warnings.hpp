@@ -12,12 +12,14 @@
 
 namespace orbis {
 
+// Warnings that differ only in their numbers, folded into one kind.
 struct WarningKind {
   std::string pattern;             // the first message with every run of digits replaced by '#'
   std::vector<std::string> shown;  // its first messages, verbatim
   std::size_t count = 0;           // every message of this kind, shown or not
 };
 
+// Groups warnings by kind, keeping the first shownPerKind messages of each verbatim.
 std::vector<WarningKind> foldWarnings(const std::vector<std::string>& warnings, std::size_t shownPerKind = 3);
 
 // The lines to print: each kind's shown messages, then "... (N more like this)" when it had more.

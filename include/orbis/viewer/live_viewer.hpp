@@ -24,36 +24,50 @@
 
 namespace orbis {
 
+// Where and how often the viewer serves.
 struct ViewerOptions {
+  // @{
+  // The address it listens on (loopback only) and the port.
   std::string host = "127.0.0.1";
   int port = 8080;
+  // @}
   // Frame messages (keypoints, pose, timing, image) per second, at most: the page draws streamed
   // updates 5 times a second (a browser on the SLAM machine takes its CPU from tracking).
   double frameRateHz = 5;
   double mapRateHz = 5;     // map snapshots per second, at most
   int imageMaxWidth = 320;  // the camera image, scaled down to this width as JPEG; 0: no image
+  // JPEG quality of the camera image.
   int jpegQuality = 70;
 };
 
 // What the viewer did, for the overhead it adds: messages built and the CPU time of its
 // publisher thread (snapshots and JSON; the server's threads only copy bytes to sockets).
 struct ViewerStats {
+  // @{
+  // Frame and map messages, bytes sent, and the CPU time of the publisher thread.
   std::size_t frameMessages = 0, mapMessages = 0, bytes = 0;
   double publisherCpuSeconds = 0;
+  // @}
 };
 
+// The live browser viewer: an HTTP server with the page (three.js, compiled in) and a
+// server-sent-events stream of frames and map changes.
 class LiveViewer final : public SlamObserver {
  public:
+  // Starts serving at options.host:options.port; throws orbis::Error when the port is taken.
   explicit LiveViewer(ViewerOptions options = {});
   ~LiveViewer() override;
   LiveViewer(const LiveViewer&) = delete;
   LiveViewer& operator=(const LiveViewer&) = delete;
 
+  // The page's address.
   std::string url() const;
+  // What it has sent so far.
   ViewerStats stats() const;
 
   void attach(MapSnapshotSource source) override;
   void onFrame(FrameSnapshot&& frame) override;
+  // The run ended: keeps serving its final map.
   void detach(MapSnapshot finalMap) override;
   // A finished run or a saved map, without SLAM: serve this map (orbis view).
   void show(MapSnapshot map);

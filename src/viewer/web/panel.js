@@ -80,6 +80,21 @@ function paintImage(frame, img) {  // the counts beside the picture are of the f
 
 function showSceneState() { setText('scene-state', JSON.stringify(window.orbisScene)); }
 
+let mergesAnnounced = 0;
+function announceMerges(merges) {
+  for (let i = mergesAnnounced; i < merges.length; ++i) {
+    const m = merges[i];
+    const item = document.createElement('li');
+    item.textContent = `frame ${m.frame}: map ${m.moved} merged into map ${m.kept}, ${m.inliers} inliers`;
+    ui('loops').appendChild(item);
+    const banner = ui('banner');
+    banner.textContent = `maps merged: map ${m.moved} into map ${m.kept}`;
+    banner.style.display = 'block';
+    setTimeout(() => { banner.style.display = 'none'; }, 4000);
+  }
+  mergesAnnounced = Math.max(mergesAnnounced, merges.length);
+}
+
 let loopsAnnounced = 0;
 function announceLoops(closures) {
   for (let i = loopsAnnounced; i < closures.length; ++i) {

@@ -22,6 +22,7 @@ class SceneStore {
     this.keyFrames = new Map();    // id -> {id, frame, parent, Twc, covisibles, loops}
     this.trajectory = [];          // x, y, z per camera
     this.loopClosures = [];
+    this.merges = [];
     this.live = null;
     this.frames = 0;
     this.grown = true;            // the arrays were replaced: geometry must be made anew
@@ -36,6 +37,7 @@ class SceneStore {
     this.live = message.live;
     this.frames = message.frames;
     this.loopClosures = message.loopClosures;
+    this.merges = message.merges || [];
     for (const id of message.removedKeyFrames) this.keyFrames.delete(id);
     for (const k of message.keyFrames) this.keyFrames.set(k.id, k);
     for (const id of message.removedPoints) this.removePoint(id);
@@ -93,6 +95,22 @@ class SceneStore {
     }
     this.ids.length = last;
     this.slotOf.delete(id);
+  }
+
+  // The atlas: the map of keyframe `id`, or of the nearest older keyframe still held (a point's
+  // first keyframe may have been culled; keyframes of one map are made in a run of ids).
+  mapOfKeyFrame(id) {
+    const k = this.keyFrames.get(id);
+    if (k) return k.map || 0;
+    let best = -1, map = 0;
+    for (const [other, kf] of this.keyFrames) if (other < id && other > best) { best = other; map = kf.map || 0; }
+    return map;
+  }
+
+  mapCount() {
+    const maps = new Set();
+    for (const k of this.keyFrames.values()) maps.add(k.map || 0);
+    return maps.size;
   }
 
   newestKeyFrame() {

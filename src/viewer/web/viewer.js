@@ -120,6 +120,16 @@ class Lines {
   }
 }
 
+// The atlas: each map its own colour (keyframes, and points outside the local map).
+const mapPalette = [0x4aa3ff, 0xff9f40, 0x9d6bff, 0x50d070, 0xff5f7a, 0xd0d040, 0x40d0d0, 0xc08060];
+const mapColour = (map) => new THREE.Color(mapPalette[map % mapPalette.length]);
+const mapKeyFrameLines = new Map();  // map id -> Lines (map 0 draws into lines.keyFrames)
+function keyFrameLinesOf(map) {
+  if (map === 0) return lines.keyFrames;
+  if (!mapKeyFrameLines.has(map)) mapKeyFrameLines.set(map, new Lines(layers.keyFrames, mapPalette[map % mapPalette.length]));
+  return mapKeyFrameLines.get(map);
+}
+
 const lines = {
   keyFrames: new Lines(layers.keyFrames, 0x4aa3ff), covisibility: new Lines(layers.covisibility, 0x3fbf7f, 0.35),
   spanningTree: new Lines(layers.spanningTree, 0xe0c060, 0.8), loops: new Lines(layers.loops, 0xff40a0),
@@ -176,14 +186,29 @@ function drawPoints() {
 function colourPoints() {
   const c = pointCloud.colours, local = store.local, n = store.count;
   const byLocalMap = view.colouring === 'local' && local.subarray(0, n).includes(1);
+  const byMap = view.colouring === 'map' || (byLocalMap && store.mapCount() > 1);
   showPointKey(byLocalMap);
   const newest = store.newestKeyFrame();
+  const colours = new Map();
+  const colourOf = (firstKeyFrame) => {
+    const map = store.mapOfKeyFrame(firstKeyFrame);
+    if (!colours.has(map)) colours.set(map, mapColour(map).lerp(new THREE.Color(0xffffff), 0.25));
+    return colours.get(map);
+  };
   for (let i = 0; i < n; ++i) {
-    if (byLocalMap) {
-      const on = local[i] === 1;
-      c[3 * i] = on ? 1.0 : 0.75;
-      c[3 * i + 1] = on ? 0.25 : 0.78;
-      c[3 * i + 2] = on ? 0.25 : 0.85;
+    if (byLocalMap && local[i] === 1) {
+      c[3 * i] = 1.0;
+      c[3 * i + 1] = 0.25;
+      c[3 * i + 2] = 0.25;
+    } else if (byMap) {
+      const m = colourOf(store.firstKeyFrame[i]);
+      c[3 * i] = m.r;
+      c[3 * i + 1] = m.g;
+      c[3 * i + 2] = m.b;
+    } else if (byLocalMap) {
+      c[3 * i] = 0.75;
+      c[3 * i + 1] = 0.78;
+      c[3 * i + 2] = 0.85;
     } else {
       const age = newest > 0 ? store.firstKeyFrame[i] / newest : 1;  // 0 oldest, 1 newest
       c[3 * i] = 0.25 + 0.75 * age;
@@ -195,10 +220,12 @@ function colourPoints() {
 
 function drawKeyFrames() {
   const { keyFrames, covisibility, spanningTree, loops } = lines;
-  for (const l of [keyFrames, covisibility, spanningTree, loops]) l.begin();
+  const mapLines = () => [...mapKeyFrameLines.values()];
+  for (const l of [keyFrames, covisibility, spanningTree, loops, ...mapLines()]) l.begin();
   const centre = (k) => [k.Twc[3], k.Twc[7], k.Twc[11]];
   for (const k of store.keyFrames.values()) {
-    addFrustum(keyFrames, k.Twc, view.frustumSize);
+    const frusta = keyFrameLinesOf(k.map || 0);
+    addFrustum(frusta, k.Twc, view.frustumSize);
     const edge = (out, other) => {
       if (!other) return;
       out.vertex(...centre(k));
@@ -208,7 +235,7 @@ function drawKeyFrames() {
     edge(spanningTree, store.keyFrames.get(k.parent));
     for (const l of k.loops) edge(loops, store.keyFrames.get(l));
   }
-  for (const l of [keyFrames, covisibility, spanningTree, loops]) l.end();
+  for (const l of [keyFrames, covisibility, spanningTree, loops, ...mapLines()]) l.end();
 }
 
 function drawTrajectory() {
@@ -283,6 +310,7 @@ function drawMap() {
                                      loopClosures: store.loopClosures.length, live: store.live });
   window.orbisScene.frames = Math.max(window.orbisScene.frames, store.frames);
   announceLoops(store.loopClosures);
+  announceMerges(store.merges);
   setText('mode', store.live === null ? 'connecting…' : store.live ? '— live' : '— finished run');
   setText('counts', `${store.keyFrames.size} / ${store.count}`);
   // The top view keeps the whole growing map in sight until the user moves the camera.

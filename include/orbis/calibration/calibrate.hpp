@@ -1,0 +1,117 @@
+// orbis/calibration/calibrate.hpp — camera calibration from views of a known pattern.
+//
+// Contract: detectView() turns one grey image into a CalibrationView (the pattern's corners, or
+// none, and how sharp the board is); detectInFolder() does so for every image of a folder, in
+// name order (the frame source `orbis calibrate images` uses; video and live sources hand their
+// frames to detectView). calibrate() then
+//   1. keeps the views that show the pattern, are sharp enough (chessboard: OpenCV's edge-rise
+//      width under maxEdgeWidth pixels) and are not near-duplicates of a kept view (mean corner
+//      displacement under duplicateFraction of the image diagonal), and, past maxViews, a
+//      well-spread subset (farthest-point sampling over where the board is, how big, how turned
+//      and how tilted);
+//   2. fits the model with OpenCV (pinhole: cv::calibrateCamera, k1 k2 p1 p2 k3; fisheye:
+//      cv::fisheye::calibrate, Kannala-Brandt k1..k4, no skew) — docs/notes/2026-11-26-fisheye.md
+//      says why OpenCV's solvers rather than orbis's LM;
+//   3. names the views whose RMS error exceeds outlierFactor x the median (and 0.5 px) as
+//      outliers and fits once more without them;
+//   4. gives each parameter's standard deviation (the residual σ times the square root of the
+//      diagonal of the inverse normal matrix with the board poses marginalised: OpenCV's
+//      stdDeviationsIntrinsics for the pinhole, the same computed here from a numeric Jacobian
+//      for the fisheye).
+// Every input it cannot use throws orbis::Error naming `source` and saying what to do: no view
+// shows the pattern, fewer than minViews usable views, views of different sizes, a fit that
+// fails or leaves the focal length or principal point unobservable (a degenerate set: the board
+// never tilted, or always in one place).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "orbis/calibration/pattern.hpp"
+#include "orbis/camera/distortion.hpp"
+#include "orbis/camera/kannala_brandt.hpp"
+#include "orbis/camera/pinhole.hpp"
+#include "orbis/geometry/se3.hpp"
+
+namespace orbis::calibration {
+
+enum class LensModel { Pinhole, Fisheye };  // pinhole: radial-tangential distortion
+LensModel parseLensModel(const std::string& name, const std::string& source = "argument --model");
+const char* toString(LensModel model);
+
+struct CalibratedCamera {
+  LensModel model = LensModel::Pinhole;
+  int width = 0, height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::vector<double> distortion;  // pinhole: k1 k2 p1 p2 k3; fisheye: k1 k2 k3 k4
+
+  PinholeCamera<double> pinhole() const { return {fx, fy, cx, cy, width, height}; }
+  RadTanDistortion<double> radTan() const;
+  KannalaBrandtCamera<double> fisheye() const;  // maxAngle: fieldOfViewAngle()
+  // The largest angle off axis any pixel of the image sees (radians; fisheye: within the
+  // polynomial's increasing range).
+  double fieldOfViewAngle() const;
+  Eigen::Vector2d project(const Eigen::Vector3d& pc) const;  // through the lens
+  // The unit ray of a pixel.
+  Eigen::Vector3d bearing(const Eigen::Vector2d& px) const;
+};
+
+struct CalibrationView {
+  std::string name;
+  cv::Size imageSize;
+  std::optional<PatternDetection> detection;
+  double edgeWidth = 0;  // chessboard: mean black-to-white rise in pixels (smaller is sharper)
+};
+
+CalibrationView detectView(const cv::Mat& gray, const std::string& name, const CalibrationPattern& pattern);
+// Every image file (png, jpg, jpeg, bmp, tif, tiff, pgm, ppm) of `folder`, sorted by name.
+// onImage(done, total) reports progress. Throws orbis::Error for a missing or image-less folder.
+std::vector<CalibrationView> detectInFolder(const std::filesystem::path& folder, const CalibrationPattern& pattern,
+                                            const std::function<void(std::size_t, std::size_t)>& onImage = {});
+
+struct CalibrationOptions {
+  LensModel model = LensModel::Pinhole;
+  int minViews = 6;
+  int maxViews = 40;
+  double maxEdgeWidth = 4.0;        // pixels
+  double duplicateFraction = 0.01;  // of the image diagonal
+  double outlierFactor = 3.0;
+  // Refused as degenerate when σ(fx)/fx or σ(fy)/fy exceeds this, or σ(cx), σ(cy) exceed
+  // maxPrincipalPointSigma of the image width.
+  double maxRelativeFocalSigma = 0.02;
+  double maxPrincipalPointSigma = 0.05;
+};
+
+struct ViewOutcome {
+  std::string name;
+  bool used = false;
+  std::string rejected;  // why not used: "no pattern", "blurred", "duplicate of X", "not selected", "outlier"
+  int corners = 0;
+  double rms = 0;        // pixels, for fitted views
+  bool outlier = false;
+  double edgeWidth = 0;
+};
+
+struct CalibrationResult {
+  CalibratedCamera camera;
+  std::vector<std::string> parameterNames;  // fx fy cx cy then the distortion's
+  std::vector<double> parameters, standardDeviations;
+  double rms = 0;  // pixels, over every corner of the used views
+  int viewsUsed = 0;
+  std::vector<ViewOutcome> views;  // one per input view, in input order
+  std::vector<SE3d> cameraFromBoard;  // per used view, in the order views lists them
+  std::vector<std::string> usedNames;
+  std::vector<std::vector<cv::Point2f>> usedCorners;  // per used view: for the coverage picture
+  std::vector<std::string> warnings;
+};
+
+CalibrationResult calibrate(const std::vector<CalibrationView>& views, const CalibrationPattern& pattern,
+                            const CalibrationOptions& options, const std::string& source);
+
+}  // namespace orbis::calibration

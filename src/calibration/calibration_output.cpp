@@ -1,0 +1,163 @@
+// Settings, report and JSON of a calibration; see orbis/calibration/calibration_output.hpp.
+#include "orbis/calibration/calibration_output.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "orbis/features/orb_params.hpp"
+#include "orbis/util/atomic_file.hpp"
+#include "orbis/util/error.hpp"
+#include "orbis/util/json.hpp"
+
+namespace orbis::calibration {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string real(double v) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  std::string s = text;
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+void writeText(const fs::path& file, const std::string& text) {
+  if (file.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(file.parent_path(), ec);
+    if (ec) throw fileError(file.parent_path().string(), "cannot create folder: " + ec.message());
+  }
+  writeFileAtomically(file, std::span<const char>(text.data(), text.size()));
+}
+
+void writeImage(const fs::path& file, const cv::Mat& image) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(file.string(), image);
+  } catch (const cv::Exception& e) {
+    throw fileError(file.string(), std::string("cannot write image: ") + e.what());
+  }
+  if (!ok) throw fileError(file.string(), "cannot write image");
+}
+
+cv::Mat cameraMatrix(const CalibratedCamera& c) { return (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1); }
+
+}  // namespace
+
+void writeCalibrationSettings(const fs::path& file, const CalibratedCamera& c, double fps) {
+  const OrbParams orb;
+  std::string y = "%YAML:1.0\n# Written by orbis calibrate: ORB-SLAM2 settings keys";
+  y += c.model == LensModel::Fisheye ? " (ORB-SLAM3's for the fisheye).\n" : ".\n";
+  y += "Sensor: \"mono\"\n\n";
+  if (c.model == LensModel::Fisheye) y += "# Kannala-Brandt equidistant fisheye.\nCamera.type: \"KannalaBrandt8\"\n";
+  y += "Camera.fx: " + real(c.fx) + "\nCamera.fy: " + real(c.fy) + "\nCamera.cx: " + real(c.cx) + "\nCamera.cy: " +
+       real(c.cy) + "\n\n";
+  if (c.model == LensModel::Fisheye) {
+    y += "Camera.k1: " + real(c.distortion[0]) + "\nCamera.k2: " + real(c.distortion[1]) + "\nCamera.k3: " +
+         real(c.distortion[2]) + "\nCamera.k4: " + real(c.distortion[3]) + "\n";
+    y += "# The widest angle off axis the image sees, degrees (the polynomial is trusted up to it).\n";
+    y += "Camera.maxAngle: " + real(std::floor(c.fieldOfViewAngle() * 180.0 / M_PI * 100.0) / 100.0) + "\n\n";
+  } else {
+    y += "Camera.k1: " + real(c.distortion[0]) + "\nCamera.k2: " + real(c.distortion[1]) + "\nCamera.p1: " +
+         real(c.distortion[2]) + "\nCamera.p2: " + real(c.distortion[3]) + "\nCamera.k3: " + real(c.distortion[4]) +
+         "\n\n";
+  }
+  y += "Camera.width: " + std::to_string(c.width) + "\nCamera.height: " + std::to_string(c.height) + "\n\n";
+  y += "Camera.fps: " + real(fps) + "\n# Colour order of the images (0: BGR, 1: RGB).\nCamera.RGB: 1\n\n";
+  y += "ORBextractor.nFeatures: " + std::to_string(orb.features) + "\n";
+  y += "ORBextractor.scaleFactor: " + real(std::round(orb.scaleFactor * 1e6) / 1e6) + "\n";
+  y += "ORBextractor.nLevels: " + std::to_string(orb.levels) + "\nORBextractor.iniThFAST: " +
+       std::to_string(orb.iniThFast) + "\nORBextractor.minThFAST: " + std::to_string(orb.minThFast) + "\n";
+  writeText(file, y);
+}
+
+cv::Mat undistortToPinhole(const CalibratedCamera& c, const cv::Mat& image, PinholeCamera<double>* pinhole) {
+  const cv::Size size(c.width, c.height);
+  cv::Mat K = cameraMatrix(c), newK, mapX, mapY;
+  if (c.model == LensModel::Fisheye) {
+    const cv::Vec4d D(c.distortion[0], c.distortion[1], c.distortion[2], c.distortion[3]);
+    cv::fisheye::estimateNewCameraMatrixForUndistortRectify(K, D, size, cv::Mat::eye(3, 3, CV_64F), newK, 0.0, size, 1.0);
+    cv::fisheye::initUndistortRectifyMap(K, D, cv::Mat::eye(3, 3, CV_64F), newK, size, CV_32FC1, mapX, mapY);
+  } else {
+    newK = cv::getOptimalNewCameraMatrix(K, c.distortion, size, 0.0, size);
+    cv::initUndistortRectifyMap(K, c.distortion, cv::Mat(), newK, size, CV_32FC1, mapX, mapY);
+  }
+  if (pinhole)
+    *pinhole = {newK.at<double>(0, 0), newK.at<double>(1, 1), newK.at<double>(0, 2), newK.at<double>(1, 2), c.width,
+                c.height};
+  cv::Mat out;
+  if (!image.empty()) cv::remap(image, out, mapX, mapY, cv::INTER_LINEAR);
+  return out;
+}
+
+std::string calibrationJson(const CalibrationResult& r, const CalibrationPattern& pattern, const fs::path& settings) {
+  const CalibratedCamera& c = r.camera;
+  JsonWriter w;
+  w.beginObject()
+      .field("model", toString(c.model))
+      .field("pattern", pattern.describe())
+      .field("width", c.width)
+      .field("height", c.height)
+      .field("fx", c.fx)
+      .field("fy", c.fy)
+      .field("cx", c.cx)
+      .field("cy", c.cy);
+  w.key("distortion").beginArray();
+  for (double d : c.distortion) w.value(d);
+  w.endArray();
+  w.key("parameters").beginObject();
+  for (std::size_t k = 0; k < r.parameterNames.size(); ++k)
+    w.key(r.parameterNames[k]).beginObject().field("value", r.parameters[k]).field("std", r.standardDeviations[k]).endObject();
+  w.endObject();
+  w.field("rms", r.rms).field("views_used", r.viewsUsed).field("views_total", r.views.size());
+  if (c.model == LensModel::Fisheye) w.field("field_of_view_deg", 2.0 * c.fieldOfViewAngle() * 180.0 / M_PI);
+  w.field("settings", settings.string());
+  w.key("views").beginArray();
+  for (const ViewOutcome& v : r.views) {
+    w.beginObject().field("name", v.name).field("used", v.used).field("corners", v.corners);
+    if (v.used || v.outlier) w.field("rms", v.rms);
+    if (v.edgeWidth > 0) w.field("edge_width_px", v.edgeWidth);
+    if (!v.rejected.empty()) w.field("rejected", v.rejected);
+    w.endObject();
+  }
+  w.endArray();
+  w.key("outliers").beginArray();
+  for (const ViewOutcome& v : r.views)
+    if (v.outlier) w.value(v.name);
+  w.endArray();
+  w.key("warnings").beginArray();
+  for (const std::string& s : r.warnings) w.value(s);
+  w.endArray();
+  w.endObject();
+  return w.str();
+}
+
+void writeCalibrationReport(const fs::path& folder, const CalibrationResult& r, const CalibrationPattern& pattern,
+                            const cv::Mat& preview) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) throw fileError(folder.string(), "cannot create the report folder: " + ec.message());
+  writeText(folder / "report.json", calibrationJson(r, pattern, "") + "\n");
+  const CalibratedCamera& c = r.camera;
+  // Coverage: where the corners fell. Bare areas are where the distortion is extrapolated.
+  cv::Mat coverage(c.height, c.width, CV_8UC3, cv::Scalar(32, 32, 32));
+  for (std::size_t v = 0; v < r.usedCorners.size(); ++v) {
+    cv::Mat hue(1, 1, CV_8UC3, cv::Scalar(static_cast<int>(v * 37 % 180), 200, 255)), bgr;
+    cv::cvtColor(hue, bgr, cv::COLOR_HSV2BGR);
+    const cv::Vec3b colour = bgr.at<cv::Vec3b>(0, 0);
+    for (const cv::Point2f& p : r.usedCorners[v]) cv::circle(coverage, p, 3, cv::Scalar(colour[0], colour[1], colour[2]), cv::FILLED);
+  }
+  char caption[200];
+  std::snprintf(caption, sizeof caption, "%s: %d views, RMS %.3f px", toString(c.model), r.viewsUsed, r.rms);
+  cv::putText(coverage, caption, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  writeImage(folder / "coverage.png", coverage);
+  if (!preview.empty()) writeImage(folder / "undistorted.png", undistortToPinhole(c, preview));
+}
+
+}  // namespace orbis::calibration
