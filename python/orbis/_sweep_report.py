@@ -22,8 +22,8 @@ FIRST_COLUMNS = ["id", "sequence", "variant", "repeat", "seed", "deterministic",
                  "merges", "relocalisations", "ate_matched", "run_seconds", "wall_seconds"]
 SUMMARY_COLUMNS = ["sequence", "variant", "runs", "failed", "ate_median", "ate_min", "ate_max", "ate_spread",
                    "rpe_median", "keyframes_median", "map_points_median", "tracked_min", "frames", "loops_median",
-                   "track_ms_median", "wall_seconds_median", "baseline_ate_median", "ratio_baseline",
-                   "reference_ate", "ratio_reference"]
+                   "maps_median", "merges_median", "track_ms_median", "wall_seconds_median", "baseline_ate_median",
+                   "ratio_baseline", "reference_ate", "ratio_reference"]
 # The per-frame tracking cost the summary shows: report.json's whole tracking stage (ORB
 # extraction included), median over the frames.
 TRACK_STAGE = "median_ms.tracking: total"
@@ -115,6 +115,8 @@ def summarise(rows: list[dict], references: dict[str, dict[str, float]],
              "tracked_min": min(_finite(r.get("frames_tracked") for r in ok), default=math.nan),
              "frames": max(_finite(r.get("frames") for r in ok), default=math.nan),
              "loops_median": _median(r.get("loops") for r in ok),
+             "maps_median": _median(r.get("maps") for r in ok),
+             "merges_median": _median(r.get("merges") for r in ok),
              "track_ms_median": _median(track),
              "wall_seconds_median": _median(r.get("wall_seconds") for r in ok)}
         base = (baseline or {}).get((seq, variant))
