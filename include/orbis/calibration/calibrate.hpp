@@ -21,7 +21,8 @@
 // Every input it cannot use throws orbis::Error naming `source` and saying what to do: no view
 // shows the pattern, fewer than minViews usable views, views of different sizes, a fit that
 // fails or leaves the focal length or principal point unobservable (a degenerate set: the board
-// never tilted, or always in one place).
+// planes of all views within minTiltDegrees of each other, or σ of the focal length or principal
+// point beyond the options' bounds).
 #pragma once
 
 #include <filesystem>
@@ -86,6 +87,8 @@ struct CalibrationOptions {
   // maxPrincipalPointSigma of the image width.
   double maxRelativeFocalSigma = 0.02;
   double maxPrincipalPointSigma = 0.05;
+  // Refused as degenerate when no two views' board planes differ in orientation by this much.
+  double minTiltDegrees = 5.0;
 };
 
 struct ViewOutcome {
