@@ -94,6 +94,9 @@ def filter_lines(lines, path):
             out[i] = line.replace('// @', '///@', 1)
             i += 1
             continue
+        if is_comment_line(line) and not in_block_comment and stripped.startswith(('// ---', '// ===')):
+            i += 1  # a section rule ("// ---- the atlas ----") titles what follows; it documents nothing
+            continue
         if is_comment_line(line) and not in_block_comment:
             j = i
             while j < n and is_comment_line(lines[j]):

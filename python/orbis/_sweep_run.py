@@ -8,7 +8,9 @@ it ends, swaps the attempt in whole, so a run folder only ever holds one finishe
 run.json (status ok/failed, the hash, the metrics or the error), report.json, trajectory.txt,
 stderr.txt. A run whose run.json says ok with the same hash is finished (finished_row) and is not
 run again. The orbis process dies with the worker that started it (PR_SET_PDEATHSIG), so a
-killed worker leaves no run behind writing into the study.
+killed worker leaves no run behind writing into the study; it runs in a session of its own, so a
+Ctrl-C typed at the study's terminal stops the study (which stops its workers) rather than
+failing the runs under way one by one.
 """
 
 from __future__ import annotations
@@ -64,8 +66,9 @@ def plan(run, program: str, study_out: Path) -> dict:
     command = ["run", seq.dataset, str(seq.path)]
     settings_text = None
     if seq.settings is not None:
-        settings_text = seq.settings.read_text() if seq.settings.exists() else ""
-        if run.overrides or run.budget is not None:
+        # A sequence still to be rendered has no settings file yet (only --dry-run plans it then).
+        settings_text = seq.settings.read_text() if seq.settings.exists() else None
+        if settings_text is not None and (run.overrides or run.budget is not None):
             settings_text = derive_settings(settings_text, run.overrides, run.budget, str(seq.settings))
         command += ["--settings", "{folder}/settings.yaml"]
     o = run.options
@@ -168,7 +171,7 @@ def _run_in(p: dict, attempt: Path) -> dict:
     with open(attempt / "stderr.txt", "w") as err:
         rc = subprocess.run([p["program"], *_fill(p["command"], attempt), "--out", str(attempt)],
                             stdout=subprocess.DEVNULL, stderr=err, stdin=subprocess.DEVNULL,
-                            preexec_fn=_die_with_parent).returncode
+                            preexec_fn=_die_with_parent, start_new_session=True).returncode
     report_file = attempt / "report.json"
     if rc != 0:
         return {"status": "failed", "error": f"orbis run exited with {rc}: {_tail(attempt / 'stderr.txt')}"}

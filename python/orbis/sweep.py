@@ -18,7 +18,6 @@ OUT/results.csv (+ .parquet with pyarrow), OUT/summary.csv and .md, OUT/plots/*.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import logging
 import os
@@ -131,6 +130,21 @@ def _failed_row(p: dict, error: str) -> dict:
     return {**{k: p[k] for k in keep}, "status": "failed", "error": error, "resumed": False}
 
 
+def _dashboard(client) -> str:
+    """The dashboard's address if its status page answers (the scheduler names one even without bokeh)."""
+    import urllib.request
+    link = client.dashboard_link
+    try:
+        direct = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # the scheduler itself, no proxy
+        with direct.open(link, timeout=3) as page:
+            # Without bokeh the scheduler still answers, with a page that asks for it.
+            if page.status == 200 and b"needs bokeh" not in page.read(2000):
+                return link
+    except OSError:
+        pass
+    return f"none ({link} needs bokeh on the scheduler's machine)"
+
+
 def _run_serial(plans: list[dict], progress: Progress) -> list[dict]:
     rows = []
     for p in plans:
@@ -146,16 +160,15 @@ def _run_dask(plans: list[dict], progress: Progress, scheduler: str | None, work
     if scheduler:
         client = Client(scheduler, timeout="30s")
     else:
-        dashboard = ":8787" if importlib.util.find_spec("bokeh") else None
         cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                               dashboard_address=dashboard, silence_logs=logging.ERROR)
+                               dashboard_address=":8787", silence_logs=logging.ERROR)
         client = Client(cluster)
     rows = []
     futures = []
     try:
         info = client.scheduler_info()
-        log(f"[sweep] Dask scheduler {info.get('address')}, {len(info.get('workers', {}))} workers; dashboard: "
-            + (client.dashboard_link if "dashboard" in info.get("services", {}) else "none (needs bokeh)"))
+        log(f"[sweep] Dask scheduler {info.get('address')}, {len(info.get('workers', {}))} workers; "
+            f"dashboard: {_dashboard(client)}")
         futures = [client.submit(execute, p, key=f"orbis-run-{p['id']}-{p['hash'][:12]}") for p in plans]
         by_key = {f.key: p for f, p in zip(futures, plans)}
         for future in as_completed(futures):
@@ -213,7 +226,10 @@ def run(study_file: str | os.PathLike, out: str | os.PathLike | None = None, *, 
     folder.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(study.file, folder / f"study{study.file.suffix}")
     _render(study, program, log)
-    plans = [plan(r, program, folder) for r in study.runs]
+    try:
+        plans = [plan(r, program, folder) for r in study.runs]
+    except ValueError as e:
+        raise StudyError(f"{study.file}: {e}") from None
     finished = [] if rerun else [row for row in map(finished_row, plans) if row]
     done_ids = {row["id"] for row in finished}
     todo = [p for p in plans if p["id"] not in done_ids]
@@ -229,6 +245,8 @@ def run(study_file: str | os.PathLike, out: str | os.PathLike | None = None, *, 
         interrupted = True
         log(f"[sweep] interrupted: {progress.resumed + progress.done} of {len(plans)} runs recorded; run the same "
             "command again to run only the rest")
+    if todo and not interrupted:
+        log(f"[sweep] {progress.done} runs in {time.time() - progress.started:.1f} s ({progress.failed} failed)")
     if not interrupted:
         remove_stale_attempts(folder / "runs")
     # This session's rows as they came back (a run Dask gave up on has no folder), then the recorded.

@@ -1,7 +1,11 @@
 #include "command.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <thread>
 #include <sstream>
@@ -51,7 +55,9 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
       if (!o) throw Error("argument " + name, "", "unknown option (see --help)");
       if (o->isFlag) {
         if (hasInline) throw Error("argument " + name, "", "is a switch and takes no value");
-        values_[name] = "1";
+        // A std::string, not "1": GCC 12 at -O3 warns (-Wrestrict, a false positive) on assigning
+        // a literal here.
+        values_[name] = std::string(1, '1');
       } else if (hasInline) {
         values_[name] = inlineValue;
       } else {
@@ -126,6 +132,42 @@ bool registerCommand(Command command) {
 }
 
 const std::map<std::string, Command>& commands() { return registry(); }
+
+std::string programUsage() {
+  std::string text =
+      "usage: orbis <command> [arguments] [--help]\n\n"
+      "orbis — visual SLAM for monocular, stereo and RGB-D cameras (ORB-SLAM2 system).\n\n"
+      "commands:\n";
+  std::size_t width = 8;
+  for (const auto& [name, cmd] : commands()) width = std::max(width, name.size());
+  for (const auto& [name, cmd] : commands())
+    text += "  " + name + std::string(width - name.size() + 1, ' ') + cmd.summary + "\n";
+  text += "\nRun 'orbis help <command>' (or 'orbis <command> --help') for the command's arguments,\n"
+          "'orbis --version' for this build's version and configuration.\n";
+  return text;
+}
+
+std::string capturedOutput(const Command& command, const std::vector<std::string>& args) {
+  std::fflush(stdout);
+  std::FILE* sink = std::tmpfile();
+  if (!sink) throw Error("standard output", "", "cannot create a temporary file to capture a command's help");
+  const int saved = ::dup(STDOUT_FILENO);
+  ::dup2(::fileno(sink), STDOUT_FILENO);
+  try {
+    command.run(args);
+  } catch (...) {
+    // the help text is what matters; a command that refuses the arguments prints none
+  }
+  std::fflush(stdout);
+  ::dup2(saved, STDOUT_FILENO);
+  ::close(saved);
+  std::string text;
+  std::rewind(sink);
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, sink)) > 0;) text.append(buffer, n);
+  std::fclose(sink);
+  return text;
+}
 
 namespace {
 volatile std::sig_atomic_t interrupted = 0;

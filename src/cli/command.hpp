@@ -66,6 +66,11 @@ bool registerCommand(Command command);
 // Blocks until SIGINT or SIGTERM (Ctrl-C), e.g. while a viewer serves a finished run.
 void waitUntilInterrupted();
 const std::map<std::string, Command>& commands();
+// What `orbis --help` prints: the usage line and every registered command with its summary.
+std::string programUsage();
+// What running a command with these arguments prints on standard output, run in-process (its
+// exit status discarded): `orbis help` and `orbis completion` read each command's --help so.
+std::string capturedOutput(const Command& command, const std::vector<std::string>& args);
 
 }  // namespace orbis::cli
 

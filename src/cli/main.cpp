@@ -9,27 +9,22 @@
 
 namespace {
 
-void printUsage() {
-  std::printf("usage: orbis <command> [arguments] [--help]\n\n"
-              "orbis — visual SLAM for monocular, stereo and RGB-D cameras (ORB-SLAM2 system).\n\n"
-              "commands:\n");
-  for (const auto& [name, cmd] : orbis::cli::commands()) std::printf("  %-8s %s\n", name.c_str(), cmd.summary.c_str());
-  std::printf("\nRun 'orbis <command> --help' for the command's arguments.\n");
-}
+void printUsage(std::FILE* out) { std::fputs(orbis::cli::programUsage().c_str(), out); }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-    printUsage();
+    printUsage(argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
   }
-  const std::string name = argv[1];
+  // `orbis --version` is `orbis version` (src/cli/cmd_version.cpp).
+  const std::string name = std::string(argv[1]) == "--version" ? "version" : argv[1];
   const auto& cmds = orbis::cli::commands();
   const auto it = cmds.find(name);
   if (it == cmds.end()) {
     std::fprintf(stderr, "orbis: unknown command '%s'\n\n", name.c_str());
-    printUsage();
+    printUsage(stderr);
     return 2;
   }
   std::vector<std::string> args(argv + 2, argv + argc);

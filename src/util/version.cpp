@@ -1,5 +1,6 @@
 #include "orbis/version.hpp"
 
 namespace orbis {
-const char* versionString() { return "0.1.0"; }
+// ORBIS_VERSION is the project() version in CMakeLists.txt.
+const char* versionString() { return ORBIS_VERSION; }
 }  // namespace orbis

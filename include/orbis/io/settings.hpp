@@ -95,9 +95,12 @@ struct Settings {
 // A settings key load() reads: its name, its kind of value ("number", "whole number", "text" or
 // "matrix") and what it sets, in a few words.
 struct SettingsKey {
+  // @{
+  // The key, its kind of value, and what it sets.
   std::string_view name;
   std::string_view type;
   std::string_view meaning;
+  // @}
 };
 
 // Every key load() reads, in the order of ORB-SLAM2's files.

@@ -75,9 +75,11 @@ struct LoopCloserOptions {
   bool fullBundleAdjustment = true;
   int fullBundleAdjustmentIterations = 10;
   // @}
+  // @{
   // Merging maps of the atlas: on, and the active map's keyframes a merge needs.
   bool mergeMaps = true;
   int mergeMinKeyFrames = 5;
+  // @}
   // Receives "loop closed: ..." lines; null prints them to stderr.
   std::function<void(const std::string&)> log;
 };
@@ -109,9 +111,11 @@ class LoopCloser {
   // Finishes queued work and joins the threads.
   void shutdown();
 
+  // @{
   // The loops closed so far, in order.
   std::vector<LoopClosureEvent> closures() const;
   std::vector<MapMergeEvent> merges() const;
+  // @}
 
  private:
   struct ConsistentGroup {

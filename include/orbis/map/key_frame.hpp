@@ -76,6 +76,7 @@ class KeyFrame {
   const MapIntrinsics intrinsics;
 
   // ---- immutable frame data --------------------------------------------------------------
+  // The frame's features (immutable).
   const FrameFeatures& features() const { return *features_; }
   // @{
   // Keypoints, the bag of words and the node-grouped features.
@@ -85,6 +86,7 @@ class KeyFrame {
   // @}
 
   // ---- pose (camera-from-world) ------------------------------------------------------------
+  // Camera from world.
   const SE3d& Tcw() const { return Tcw_; }
   // @{
   // World from camera, the camera centre, and setting the pose.
@@ -94,6 +96,7 @@ class KeyFrame {
   // @}
 
   // ---- map-point associations ----------------------------------------------------------
+  // The map point of keypoint i, or null.
   MapPoint* point(std::size_t i) const { return points_[i]; }
   // @{
   // The map point of each keypoint (null: none); setting and erasing them.
@@ -127,6 +130,7 @@ class KeyFrame {
   // @}
 
   // ---- spanning tree and loop edges ----------------------------------------------------
+  // Its parent in the spanning tree (null for a map's root).
   KeyFrame* parent() const { return parent_; }
   // @{
   // Spanning-tree children and parent changes; loop edges (a keyframe with one is protected from
@@ -141,6 +145,7 @@ class KeyFrame {
   // @}
 
   // ---- life cycle ------------------------------------------------------------------------
+  // Whether it was culled.
   bool isBad() const { return bad_; }
   // Keyframes under loop-closing use are protected from culling.
   void setProtected(bool p) { protected_ = p || !loopEdges_.empty(); }
@@ -150,16 +155,20 @@ class KeyFrame {
   // does) and detaches its map points. Returns false when it is protected or the root.
   bool setBad();
 
+  // @{
   // ---- the atlas (map mutex held) --------------------------------------------------------
   // The map of the atlas it belongs to (map.hpp); changes when its map is merged into another.
   std::uint32_t mapId() const { return mapId_; }
   void setMapId(std::uint32_t id) { mapId_ = id; }
+  // @}
+  // @{
   // The first keyframe of its map: never culled. A gauge is a root BA keeps fixed; a root stops
   // being one when its map is merged into another (that map's root holds the gauge).
   bool isMapRoot() const { return mapRoot_; }
   void setMapRoot(bool root) { mapRoot_ = root; gauge_ = root; }
   bool isGauge() const { return gauge_; }
   void setGauge(bool gauge) { gauge_ = gauge && mapRoot_; }
+  // @}
 
   // Relative pose to the parent recorded when the keyframe went bad, so trajectories can still
   // express frames referenced to it.

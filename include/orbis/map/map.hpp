@@ -28,6 +28,7 @@ namespace orbis {
 
 // One map of the atlas, as the container records it.
 struct AtlasMapRecord {
+  // The map's id.
   std::uint32_t id = 0;
   std::uint64_t startFrame = 0;             // the frame that opened it (0 for the first map)
   std::optional<std::uint32_t> mergedInto;  // set once it has been merged into another map
@@ -71,18 +72,23 @@ class Map {
   KeyFrame* origin() const { return keyFrames_.empty() ? nullptr : keyFrames_.front().get(); }
 
   // ---- the atlas (caller holds mutex()) ---------------------------------------------------
+  // @{
+  // The active map's id, read and set.
   std::uint32_t activeMapId() const { return active_; }
   void setActiveMap(std::uint32_t id) { active_ = id; }
+  // @}
   // Opens an empty map, made active; returns its id.
   std::uint32_t startNewMap(std::uint64_t frameIndex);
   // Every map ever opened, merged ones included, by id.
   const std::vector<AtlasMapRecord>& mapRecords() const { return records_; }
+  // @{
   // Good keyframes and points of one map, ordered by id (a point belongs to its reference
   // keyframe's map).
   std::vector<KeyFrame*> keyFrames(std::uint32_t mapId) const;
   std::vector<MapPoint*> mapPoints(std::uint32_t mapId) const;
   std::size_t keyFrameCount(std::uint32_t mapId) const;
   std::size_t mapPointCount(std::uint32_t mapId) const;
+  // @}
   // Relabels every keyframe (bad ones too) of map `from` as map `into`'s; `from`'s root stops
   // being a BA gauge. Poses are the caller's business (they must already be in into's frame).
   void mergeInto(std::uint32_t from, std::uint32_t into);

@@ -133,6 +133,8 @@ class Problem {
   }
 
   // ---- LinearizedModel interface (used by levenbergMarquardt) ----
+  // Whether any pose or point is free (the LinearizedModel interface levenbergMarquardt drives,
+  // from here on).
   bool hasFreeVariables() const { return !freePoseIds_.empty() || !freePointIds_.empty(); }
   // Evaluates residuals and Jacobians at the current values and builds the normal equations;
   // returns the cost.

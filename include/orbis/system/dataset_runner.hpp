@@ -53,10 +53,12 @@ struct RunOptions {
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
   SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned
   bool stats = false;  // diagnosis: outDir/stats.jsonl, one line per frame and per keyframe (StageTimer events)
+  // @{
   // The atlas (docs/guide/atlas.md): off keeps ORB-SLAM2's single map; when to open a new map.
   bool atlas = true;
   int newMapAfterLostFrames = 10;
   double newMapAfterLostSeconds = 0.3;
+  // @}
 };
 
 // What a run did: its counters, timing, accuracy and warnings (report.json).
@@ -90,11 +92,13 @@ struct RunReport {
   // @}
   // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.
   std::vector<LoopClosureEvent> loopClosures;
+  // @{
   // The atlas: every map opened (report.json "maps"), the merges in order, and per tracked frame
   // the map it was tracked in (trajectory_maps.txt).
   std::vector<AtlasMapInfo> maps;
   std::vector<MapMergeEvent> merges;
   std::vector<std::uint32_t> frameMaps;
+  // @}
 };
 
 // Runs SLAM over the whole sequence and writes trajectory.txt, keyframes.txt, report.json, map.ply

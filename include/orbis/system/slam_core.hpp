@@ -45,12 +45,14 @@ struct SlamOptions {
   // until mapping is idle, which costs wall time but no frames.
   bool liveCamera = false;
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
+  // @{
   // The atlas (issue 32; docs/guide/atlas.md): a new map when relocalisation has failed on
   // newMapAfterLostFrames frames that could start one, over newMapAfterLostSeconds; maps merged
   // when loop closing recognises a place of another. Off: ORB-SLAM2's single map.
   bool atlas = true;
   int newMapAfterLostFrames = 10;
   double newMapAfterLostSeconds = 0.3;
+  // @}
 };
 
 // What a run has done so far.
@@ -67,7 +69,10 @@ struct SlamStats {
   std::optional<std::uint64_t> initialisedAtFrame;
   std::map<std::string, std::size_t> initialisationWaits;
   // @}
+  // @{
+  // Maps ever opened in the atlas, and merges done.
   std::size_t maps = 1, mapMerges = 0;  // maps ever opened in the atlas, merges done
+  // @}
 };
 
 // Everything after feature extraction: tracking, local mapping, loop closing and relocalisation
@@ -95,10 +100,12 @@ class SlamCore {
   // Per frame of trajectory(): the map it was tracked in, and the map holding it now (they
   // differ once its map was merged into another; then its pose is in that map's frame).
   std::vector<std::uint32_t> trajectoryMaps(bool current = false) const;
+  // @{
   // The atlas: every map ever opened (merged ones flagged), the active one, the merges so far.
   std::vector<AtlasMapInfo> maps() const;
   std::uint32_t activeMapId() const;
   std::vector<MapMergeEvent> merges() const;
+  // @}
   Trajectory keyFrameTrajectory() const;  // every good keyframe, camera-to-world
   // @{
   // The map's points, the counters, the tracking state, and localisation-only mode.

@@ -175,7 +175,8 @@ RelocalisationStats SlamCore<Sensor>::relocalisationStats() const {
 // wall time (teddy monocular: 11 s for 6.7 s of frames on two cores, 7 s without), so with a live
 // camera (SlamOptions::liveCamera) tracking keeps the camera's rate instead: mapping gets what is
 // left of the frame period (1/fps after extraction and tracking), and tracking runs on if it has
-// not finished. The metric sensors need no wait: each frame measures its own depth.
+// not finished. The metric sensors need no wait: each frame measures its own depth. Measurements:
+// docs/notes/2026-11-24-monocular-threaded-wait.md.
 template <SensorConfiguration Sensor>
 void SlamCore<Sensor>::waitForMappingAfterKeyFrame(std::chrono::steady_clock::time_point trackingStart,
                                                    double extractionMs) {

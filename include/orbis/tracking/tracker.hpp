@@ -56,6 +56,7 @@ struct TrackerOptions {
   int minInitialisationMatches = 100;    // windowed matches below this drop the reference
   float initialisationWindow = 100;      // px around the previous match (ORB-SLAM's)
   unsigned initialisationSeed = 5489;    // the two-view RANSAC's generator (deterministic runs)
+  // @{
   // The atlas (issue 32): when relocalisation has failed on at least newMapAfterLostFrames frames
   // that could start a map, spanning at least newMapAfterLostSeconds, a new map is opened (the
   // old ones stay): at once for metric sensors, by two-view initialisation for monocular. Off:
@@ -63,6 +64,7 @@ struct TrackerOptions {
   bool atlas = true;
   int newMapAfterLostFrames = 10;
   double newMapAfterLostSeconds = 0.3;
+  // @}
 };
 
 // What tracking made of a frame.

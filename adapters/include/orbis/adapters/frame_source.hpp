@@ -31,6 +31,7 @@
 
 namespace orbis {
 
+// One frame from a streaming source: its images, timestamp and capture time.
 struct SourceFrame {
   std::size_t index = 0;   // position in the source (a live source's dropped frames count too)
   double timestamp = 0.0;  // seconds
@@ -38,6 +39,7 @@ struct SourceFrame {
   cv::Mat right;           // stereo only
   cv::Mat depth;           // RGB-D only: raw CV_16U as stored
   std::chrono::steady_clock::time_point captured{};  // when the frame was captured or read
+  // What was wrong with this frame and survived.
   std::vector<std::string> warnings;
 };
 
@@ -46,6 +48,7 @@ enum class StereoPacking { None, SideBySide, TopBottom };
 // "side-by-side" or "top-bottom" (also "none"); throws orbis::Error(source) otherwise.
 StereoPacking parseStereoPacking(const std::string& name, const std::string& source = "stereo packing");
 
+// How a frame source reads its input.
 struct SourceOptions {
   // Frame rate for sources without timestamps (a video container without one, a folder without
   // a times file); for a video, also overrides the container's timestamps. 0: not given.
@@ -54,6 +57,7 @@ struct SourceOptions {
   // nanoseconds when the values exceed 1e11) that overrides every other timestamp: e.g. the
   // rgb.txt of the TUM sequence a video was encoded from, so frame i gets image i's time.
   std::optional<std::filesystem::path> timesFile;
+  // How a stereo camera packs its two views into one frame.
   StereoPacking stereo = StereoPacking::None;
   // Read images as grey (the pipeline's input) instead of colour: cheaper to decode and to copy.
   bool grey = false;
@@ -61,6 +65,8 @@ struct SourceOptions {
   double stallSeconds = 5.0;
 };
 
+// Frames arriving one after another (a video, a folder, a live camera, or a dataset read in order),
+// without random access or a known count.
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
@@ -70,12 +76,16 @@ class FrameSource {
   virtual std::optional<SourceFrame> next() = 0;
   // What the frames come from, e.g. "video:/data/clip.mp4", "camera:/dev/video0".
   virtual std::string name() const = 0;
+  // @{
+  // The sensor the frames are for, and whether they come from a live device.
   virtual SensorKind sensor() const { return SensorKind::Monocular; }
   virtual bool live() const { return false; }
+  // @}
   // How many frames will come, when known in advance (files, folders); a progress bar's total.
   virtual std::optional<std::size_t> expectedFrames() const { return std::nullopt; }
   // The calibration the source carries (only a dataset's); empty: a settings file must give it.
   virtual std::optional<DatasetCamera> camera() const { return std::nullopt; }
+  // Lens distortion still present in the images (zero: undistorted or unknown).
   virtual RadTanDistortion<double> distortion() const { return {}; }
   // Camera-to-world poses of the left/colour camera, when known; empty otherwise.
   virtual const Trajectory& groundTruth() const { return noGroundTruth_; }
@@ -90,8 +100,11 @@ class FrameSource {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  protected:
+  // @{
+  // Warnings of opening, and the cancel check, for derived sources.
   std::vector<std::string> warnings_;
   std::function<bool()> cancel_;
+  // @}
 
  private:
   Trajectory noGroundTruth_;
