@@ -459,7 +459,24 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, const Cal
     fit = fitModel(options.model, object, image, *size, source);
     selected = inliers;
   }
-  // 4. A set that does not pin the focal length or principal point down is degenerate.
+  // 4. A set that does not pin the focal length or principal point down is degenerate: the board
+  // never tilted (Zhang's method needs planes in different orientations), or the uncertainty says so.
+  double widestTurn = 0;
+  for (std::size_t a = 0; a < fit.rvecs.size(); ++a)
+    for (std::size_t b = a + 1; b < fit.rvecs.size(); ++b) {
+      const Eigen::Vector3d na = poseOf(fit.rvecs[a], fit.tvecs[a]).rotationMatrix().col(2);
+      const Eigen::Vector3d nb = poseOf(fit.rvecs[b], fit.tvecs[b]).rotationMatrix().col(2);
+      widestTurn = std::max(widestTurn, std::acos(std::clamp(na.dot(nb), -1.0, 1.0)));
+    }
+  if (widestTurn < options.minTiltDegrees * M_PI / 180.0) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "the views do not determine the camera (a degenerate set): the board's orientation varies by "
+                  "%.1f degrees over all views. Show it tilted by 20-45 degrees about both axes, at several "
+                  "distances and in every part of the image",
+                  widestTurn * 180.0 / M_PI);
+    throw Error(source, "", text);
+  }
   const double width = static_cast<double>(size->width);
   if (fit.sigmas[0] > options.maxRelativeFocalSigma * fit.camera.fx ||
       fit.sigmas[1] > options.maxRelativeFocalSigma * fit.camera.fy ||

@@ -2,12 +2,16 @@
 // from views of a chessboard or ChArUco board (orbis/calibration/calibrate.hpp does the work).
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "command.hpp"
+#include "orbis/adapters/frame_source.hpp"
 #include "orbis/calibration/calibrate.hpp"
 #include "orbis/calibration/calibration_output.hpp"
 #include "orbis/util/error.hpp"
@@ -19,24 +23,51 @@ namespace {
 namespace fs = std::filesystem;
 using namespace orbis::calibration;
 
-// The frames of a source as calibration views. Images: a folder, read directly; video files and
-// live cameras come through the streaming frame sources once they are in the library.
-std::vector<CalibrationView> collectViews(const std::string& kind, const fs::path& path,
-                                          const CalibrationPattern& pattern, bool progress) {
+// The frames of a source as calibration views, and the image of each view that shows the pattern
+// (for the report's preview). Images: a folder, read directly by the calibration library; video
+// files and live cameras through the streaming frame sources, one frame every `step` seconds
+// (a camera for at most `seconds`).
+struct CollectedViews {
+  std::vector<CalibrationView> views;
+  std::map<std::string, cv::Mat> images;
+};
+
+CollectedViews collectViews(const std::string& kind, const std::string& path, const CalibrationPattern& pattern,
+                            double step, double seconds, bool progress) {
+  CollectedViews out;
   if (kind == "images") {
     std::optional<ProgressBar> bar;
-    std::vector<CalibrationView> views = detectInFolder(path, pattern, [&](std::size_t done, std::size_t total) {
+    out.views = detectInFolder(path, pattern, [&](std::size_t done, std::size_t total) {
       if (!bar) bar.emplace("calibrate: detecting", total, progress);
       bar->update(done);
     });
     if (bar) bar->finish();
-    return views;
+    return out;
   }
-  if (kind == "video" || kind == "camera")
-    throw Error("argument " + kind, "",
-                "calibrating from a " + kind + " is not available in this build yet: extract frames into a folder "
-                "(e.g. ffmpeg -i VIDEO -vf fps=2 frames/%04d.png) and run `orbis calibrate images frames/ ...`");
-  throw Error("argument SOURCE", "", "expected images, video or camera, not '" + kind + "'");
+  if (kind != "video" && kind != "camera")
+    throw Error("argument SOURCE", "", "expected images, video or camera, not '" + kind + "'");
+  SourceOptions options;
+  options.grey = true;
+  const std::unique_ptr<FrameSource> source = kind == "video" ? openVideoSource(path, options) : openCameraSource(path, options);
+  ProgressBar bar("calibrate: " + source->name(), source->expectedFrames().value_or(0), progress);
+  double last = -std::numeric_limits<double>::infinity(), first = std::numeric_limits<double>::quiet_NaN();
+  std::size_t read = 0;
+  while (const std::optional<SourceFrame> frame = source->next()) {
+    ++read;
+    bar.update(read);
+    if (std::isnan(first)) first = frame->timestamp;
+    if (kind == "camera" && frame->timestamp - first > seconds) break;
+    if (frame->timestamp - last < step) continue;
+    last = frame->timestamp;
+    const std::string name = "frame_" + std::to_string(frame->index);
+    CalibrationView view = detectView(frame->image, name, pattern);
+    if (view.detection) out.images[name] = frame->image;
+    out.views.push_back(std::move(view));
+  }
+  bar.finish();
+  if (out.views.empty())
+    throw Error(source->name(), "", "delivered no frame" + (source->endReason().empty() ? std::string() : ": " + source->endReason()));
+  return out;
 }
 
 void printSummary(const CalibrationResult& r, const fs::path& out, const std::optional<fs::path>& report) {
@@ -73,6 +104,8 @@ int runCalibrate(const std::vector<std::string>& args) {
       .option("--max-views", "N", "most views fitted (a well-spread subset beyond)", "40")
       .option("--max-blur", "PX", "chessboard: views whose black-to-white edge rise is wider are blurred", "4")
       .option("--fps", "HZ", "Camera.fps written to the settings", "30")
+      .option("--step", "S", "video and camera: use one frame every S seconds", "0.5")
+      .option("--seconds", "S", "camera: calibrate from this many seconds of frames", "60")
       .flag("--json", "print the result as one JSON object");
   if (!p.parse(args)) return 0;
   if (!p.getOptional("--pattern")) throw Error("argument --pattern", "", "missing: say which board the images show, e.g. --pattern chessboard:9x6:0.025");
@@ -91,14 +124,20 @@ int runCalibrate(const std::vector<std::string>& args) {
   const std::optional<fs::path> report = p.getOptional("--report") ? std::optional<fs::path>(p.get("--report")) : std::nullopt;
   const bool json = p.has("--json");
 
+  const double step = p.getDouble("--step"), seconds = p.getDouble("--seconds");
+  if (!(step >= 0)) throw Error("argument --step", "", "must not be negative");
+  if (!(seconds > 0)) throw Error("argument --seconds", "", "must be positive");
   const fs::path source = p.pos(1);
-  const std::vector<CalibrationView> views = collectViews(p.pos(0), source, pattern, !json);
-  const CalibrationResult result = calibrate(views, pattern, options, source.string());
+  const CollectedViews collected = collectViews(p.pos(0), p.pos(1), pattern, step, seconds, !json);
+  const CalibrationResult result = calibrate(collected.views, pattern, options, source.string());
   writeCalibrationSettings(out, result.camera, fps);
   if (report) {
     cv::Mat preview;
-    if (p.pos(0) == "images" && !result.usedNames.empty())
-      preview = cv::imread((source / result.usedNames.front()).string(), cv::IMREAD_UNCHANGED);
+    if (!result.usedNames.empty()) {
+      const std::string& first = result.usedNames.front();
+      preview = p.pos(0) == "images" ? cv::imread((source / first).string(), cv::IMREAD_UNCHANGED)
+                                     : collected.images.at(first);
+    }
     writeCalibrationReport(*report, result, pattern, preview);
   }
   if (json) std::printf("%s\n", calibrationJson(result, pattern, out).c_str());

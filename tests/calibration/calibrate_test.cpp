@@ -58,7 +58,7 @@ std::vector<CalibrationView> renderAndDetect(const CalibratedCamera& truth, cons
 }
 
 void expectRecovered(const CalibrationResult& r, const CalibratedCamera& truth, double focalTolerance = 0.005,
-                     double principalTolerance = 1.0) {
+                     double principalTolerance = 1.0, double pixelTolerance = 3.0) {
   std::printf("  %s: fx %.3f (true %.3f, sigma %.3f) fy %.3f (%.3f) cx %.3f (%.3f, sigma %.3f) cy %.3f (%.3f), RMS %.3f px, %d views\n",
               toString(truth.model), r.camera.fx, truth.fx, r.standardDeviations[0], r.camera.fy, truth.fy, r.camera.cx,
               truth.cx, r.standardDeviations[2], r.camera.cy, truth.cy, r.rms, r.viewsUsed);
@@ -79,7 +79,7 @@ void expectRecovered(const CalibrationResult& r, const CalibratedCamera& truth, 
     }
   // Not a pixel: a principal point error within its sigma shifts every pixel that much.
   std::printf("  worst pixel disagreement over the image: %.3f px\n", worst);
-  EXPECT_LT(worst, 3.0);
+  EXPECT_LT(worst, pixelTolerance);
 }
 
 TEST(Calibrate, PinholeWithDistortionRecovered) {
@@ -97,7 +97,8 @@ TEST(Calibrate, FisheyeAt180DegreesRecovered) {
   options.model = LensModel::Fisheye;
   const CalibrationResult r = calibrate(renderAndDetect(truth, pattern, 20, 5), pattern, options, "rendered");
   expectRecovered(r, truth);
-  EXPECT_NEAR(r.camera.fieldOfViewAngle() * 2 * 180 / M_PI, truth.fieldOfViewAngle() * 2 * 180 / M_PI, 2.0);
+  // The angle across the width (boards reached 80 degrees off axis; 90 is a short extrapolation).
+  EXPECT_NEAR(r.camera.fisheye().horizontalFieldOfViewDegrees(), truth.fisheye().horizontalFieldOfViewDegrees(), 2.0);
 }
 
 TEST(Calibrate, WrittenSettingsLoadAsTheCamera) {
@@ -130,7 +131,7 @@ TEST(Calibrate, CharucoBoardDetectedAndCalibrated) {
   EXPECT_GE(found, 18);
   // A 7x5 ChArUco board has 24 corners against the chessboard's 54: looser bounds.
   const CalibrationResult r = calibrate(views, pattern, {}, "rendered charuco");
-  expectRecovered(r, truth, 0.01, 3.0);
+  expectRecovered(r, truth, 0.01, 3.0, 6.0);
 }
 
 TEST(Calibrate, PatternSpecErrors) {

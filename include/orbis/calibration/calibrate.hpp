@@ -21,7 +21,8 @@
 // Every input it cannot use throws orbis::Error naming `source` and saying what to do: no view
 // shows the pattern, fewer than minViews usable views, views of different sizes, a fit that
 // fails or leaves the focal length or principal point unobservable (a degenerate set: the board
-// never tilted, or always in one place).
+// planes of all views within minTiltDegrees of each other, or σ of the focal length or principal
+// point beyond the options' bounds).
 #pragma once
 
 #include <filesystem>
@@ -112,6 +113,8 @@ struct CalibrationOptions {
   double maxRelativeFocalSigma = 0.02;
   // Largest σ(cx), σ(cy) as a share of the image width.
   double maxPrincipalPointSigma = 0.05;
+  // Refused as degenerate when no two views' board planes differ in orientation by this much.
+  double minTiltDegrees = 5.0;
 };
 
 // What became of one input view.
