@@ -13,7 +13,7 @@ the first of the next), which only the rest of the loop ties together. Pure Pyth
 to WORK/atlas_corridor.json.
 
   benchmarks/atlas_corridor.py [--orbis BIN] [--work DIR] [--seeds 1,2] [--blackouts 100:30,200:30]
-                               [--sensors rgbd,stereo,mono]
+                               [--sensors rgbd,stereo,mono] [--reuse]
 """
 import argparse
 import json
@@ -23,6 +23,11 @@ import subprocess
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FPS = 30.0
+START_TIME = 1.0  # orbis synth: the timestamp of frame 0
+
+
+def frame_of(t):
+    return round((t - START_TIME) * FPS)
 
 
 def quat_to_matrix(qx, qy, qz, qw):
@@ -44,7 +49,7 @@ def read_tum(path):
         if line.startswith('#') or not line.strip():
             continue
         v = [float(x) for x in line.split()]
-        poses[round(v[0] * FPS)] = (quat_to_matrix(*v[4:8]), v[1:4])
+        poses[frame_of(v[0])] = (quat_to_matrix(*v[4:8]), v[1:4])
     return poses
 
 
@@ -55,7 +60,7 @@ def read_euroc_gt(path):
             continue
         v = [float(x) for x in line.split(',')]
         t = v[0] * 1e-9
-        poses[round(t * FPS)] = (quat_to_matrix(v[5], v[6], v[7], v[4]), v[1:4])
+        poses[frame_of(t)] = (quat_to_matrix(v[5], v[6], v[7], v[4]), v[1:4])
     return poses
 
 
@@ -65,7 +70,7 @@ def read_maps(path):
         if line.startswith('#') or not line.strip():
             continue
         t, tracked_in, _ = line.split()
-        maps[round(float(t) * FPS)] = int(tracked_in)
+        maps[frame_of(float(t))] = int(tracked_in)
     return maps
 
 
@@ -79,8 +84,10 @@ def render(orbis, work, seed, black, layout):
     return folder
 
 
-def run(orbis, work, seq, kind, sensor, single, tag):
+def run(orbis, work, seq, kind, sensor, single, tag, reuse):
     out = os.path.join(work, tag)
+    if reuse and os.path.exists(os.path.join(out, "report.json")):
+        return out
     settings = os.path.join(seq, "settings_mono.yaml" if sensor == "mono" else "settings.yaml")
     cmd = [orbis, "run", kind, seq, "--settings", settings, "--deterministic", "--out", out]
     if sensor == "mono":
@@ -142,6 +149,7 @@ def main():
     ap.add_argument("--seeds", default="1,2")
     ap.add_argument("--blackouts", default="100:30,200:30")
     ap.add_argument("--sensors", default="rgbd,stereo,mono")
+    ap.add_argument("--reuse", action="store_true", help="score existing runs in WORK instead of running again")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     rows = []
@@ -158,7 +166,7 @@ def main():
                 for single in (False, True):
                     mode = "single" if single else "atlas"
                     tag = f"out_{sensor}_s{seed}_b{start}_{count}_{mode}"
-                    out = run(args.orbis, args.work, seq, layout, sensor, single, tag)
+                    out = run(args.orbis, args.work, seq, layout, sensor, single, tag, args.reuse)
                     try:
                         row = score(out, gt, start, count, sensor)
                     except (OSError, ValueError, KeyError) as e:
