@@ -8,6 +8,7 @@
 // camera["depth_scale"]) or None. Ground truth is an N x 8 array of TUM rows, camera-to-world.
 // Bad paths raise MissingFileError, malformed files orbis.Error naming file and line.
 #include <pybind11/stl.h>
+#include <variant>
 #include <pybind11/stl/filesystem.h>
 
 #include "arrays.hpp"
@@ -92,7 +93,9 @@ void bindDatasets(py::module_& m) {
       .def_property_readonly("kind", [](const DatasetReader& d) { return std::string(toString(d.kind())); })
       .def_property_readonly("sensor", [](const DatasetReader& d) { return std::string(toString(d.sensor())); })
       .def_property_readonly("root", &DatasetReader::root)
-      .def_property_readonly("camera", [](const DatasetReader& d) { return describeCamera(d.camera()); },
+      .def_property_readonly("camera", [](const DatasetReader& d) {
+                               return describeCamera(std::visit([](const auto& c) -> CameraVariant { return c; }, d.camera()));
+                             },
                              "The dataset's own calibration, as Settings.camera describes one.")
       .def_property_readonly("ground_truth", [](const DatasetReader& d) { return trajectoryToArray(d.groundTruth()); },
                              "(N, 8) float64 TUM rows t x y z qx qy qz qw, camera-to-world (empty when none).")
