@@ -9,7 +9,9 @@
 // keyframe and point, the origin fixed, and returns the optimised values without writing them:
 // the loop closer merges them through the spanning tree. Both run on the sensor's camera model and
 // robust kernel (callers pass Sensor::Camera and Sensor::RobustKernel): depth observations of an RGB-D sensor as
-// a whitened disparity, of a stereo pair as (uL, v, uR). Bodies: map_bundle_adjustment_impl.hpp.
+// a whitened disparity, of a stereo pair as (uL, v, uR). `threads` share the solver's Schur
+// complement (optim/solver_options.hpp): bit-identical results at any count.
+// Bodies: map_bundle_adjustment_impl.hpp.
 #pragma once
 
 #include <atomic>
@@ -33,7 +35,7 @@ struct LocalBundleAdjustmentStats {
 
 template <optim::RobustKernel Kernel, CameraModel Camera>
 LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map, KeyFrame* kf,
-                                                 std::atomic<bool>* abort);
+                                                 std::atomic<bool>* abort, int threads = 2);
 
 struct FullBundleAdjustmentResult {
   std::map<KeyFrameId, SE3d> keyFramePoses;            // Tcw of every optimised keyframe
@@ -43,7 +45,7 @@ struct FullBundleAdjustmentResult {
 
 template <optim::RobustKernel Kernel, CameraModel Camera>
 FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
-                                                std::atomic<bool>* abort);
+                                                std::atomic<bool>* abort, int threads = 2);
 
 }  // namespace orbis
 

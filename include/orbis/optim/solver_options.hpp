@@ -34,6 +34,9 @@ struct SolverOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   int denseThreshold = 400;
   const std::atomic<bool>* abortFlag = nullptr;
+  // Threads for the Schur complement, the back-substitution and the cost (util/parallel_for.hpp).
+  // Every sum keeps its serial order, so the result is bit-identical at any count.
+  int threads = 1;
 };
 
 enum class Termination {

@@ -108,6 +108,7 @@ struct Rgbd {
    public:
     FeatureBuilder(const Camera& camera, const OrbParams& orb) : camera_(camera), metric_(camera), extractor_(orb) {
       metric_.depthScale = 1.0;
+      extractor_.setParallelLevels(true);  // one image per frame: its levels use both cores
     }
     FrameFeatures build(const Input& in) {
       return extractRgbd(extractor_, in.image, in.depth, in.depth.depth() == CV_32F ? metric_ : camera_);
@@ -142,7 +143,10 @@ struct Monocular {
   class FeatureBuilder {
    public:
     FeatureBuilder(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens = {})
-        : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {}
+        : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {
+      trackingExtractor_.setParallelLevels(true);  // one image per frame: its levels use both cores
+      initialisationExtractor_.setParallelLevels(true);
+    }
     FrameFeatures build(const Input& in) {
       return extractMonocular(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, camera_, lens_);
     }
