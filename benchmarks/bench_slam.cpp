@@ -47,6 +47,7 @@ struct Case {
   std::optional<SensorKind> sensor;  // empty: the dataset's own
   int features;                      // the dataset's default budget (dataset_runner.cpp)
   double orbSlam2Ms;                 // issue 35's ORB-SLAM2 median, 0 when not measured
+  std::optional<fs::path> settings;  // ORB-SLAM2 settings YAML, as `orbis run --settings`
 };
 
 struct Options {
@@ -196,6 +197,7 @@ CaseResult runCase(const Case& c, const Options& options, bool realtime) {
     run_options.outDir = options.work / (c.label + (realtime ? " realtime " : " ") + std::to_string(run));
     run_options.progress = false;
     run_options.realtime = realtime;
+    run_options.settings = c.settings;
     const RunReport report = runDataset(*reader, run_options);
     addReport(result, report, run_options.outDir, *reader);
     std::fprintf(stderr, "bench_slam: %s%s run %d: %.1f s, load %s\n", c.label.c_str(), realtime ? " realtime" : "",
@@ -229,7 +231,11 @@ Case parseSequence(const std::string& spec) {
   std::string label = fs::path(path).filename().string();
   if (label.empty()) label = fs::path(path).parent_path().filename().string();
   label += sensor == SensorKind::Monocular ? " mono" : "";
-  return {label, kind, path, sensor, defaultFeatures(kind), 0};
+  // A folder written by `orbis synth` carries its calibration: settings.yaml, settings_mono.yaml.
+  std::optional<fs::path> settings;
+  const fs::path yaml = fs::path(path) / (sensor == SensorKind::Monocular ? "settings_mono.yaml" : "settings.yaml");
+  if (fs::exists(yaml)) settings = yaml;
+  return {label, kind, path, sensor, defaultFeatures(kind), 0, settings};
 }
 
 void usage() {
@@ -240,7 +246,8 @@ void usage() {
       "cv::ORB's extraction measured alternately in the same process (docs/guide/speed.md).\n"
       "  --runs N            runs per case, alternating cv::ORB and orbis (default 3)\n"
       "  --only LABEL        only cases whose label contains LABEL (repeatable), e.g. mono, kitti06\n"
-      "  --sequence SPEC     add a sequence: KIND (tum, euroc, kitti) : PATH [: mono|stereo|rgbd]\n"
+      "  --sequence SPEC     add a sequence: KIND (tum, euroc, kitti) : PATH [: mono|stereo|rgbd]; its\n"
+      "                      settings.yaml (settings_mono.yaml for mono) is used when present\n"
       "  --realtime          also run the monocular cases as a live camera: wait for mapping, local BA, ATE, scale\n"
       "  --realtime-only     only the live-camera runs\n"
       "  --data DIR          the shared datasets (default $ORBIS_DATA, else ../shared/datasets)\n"
