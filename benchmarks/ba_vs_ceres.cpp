@@ -12,6 +12,9 @@
 // function returns [J_δ 0] for the block and PlusJacobian is [I; 0], so Ceres sees J_δ exactly.
 // After the runs a table prints both times, both final costs and the ratio orbis/Ceres.
 // ORBIS_BAL_FILE=problem-*.txt adds a real BAL problem.
+// ORBIS_BA_THREADS=N (default 1) gives both solvers N threads (orbis: SolverOptions::threads,
+// Ceres: num_threads); with N > 1 the table compares wall time instead, since CPU time then sums
+// the threads.
 #include "ba_problem_generator.hpp"
 
 #include "orbis/io/bal.hpp"
@@ -21,6 +24,7 @@
 #include <benchmark/benchmark.h>
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -36,12 +40,21 @@ constexpr double kFunctionTolerance = 1e-8;
 constexpr double kParameterTolerance = 1e-10;
 constexpr double kGradientTolerance = 1e-10;
 
+int solverThreads() {
+  static const int threads = [] {
+    const char* env = std::getenv("ORBIS_BA_THREADS");
+    return env && *env ? std::max(1, std::atoi(env)) : 1;
+  }();
+  return threads;
+}
+
 optim::SolverOptions orbisOptions() {
   optim::SolverOptions o;
   o.maxIterations = kMaxIterations;
   o.functionTolerance = kFunctionTolerance;
   o.parameterTolerance = kParameterTolerance;
   o.gradientTolerance = kGradientTolerance;
+  o.threads = solverThreads();
   return o;
 }
 
@@ -55,7 +68,7 @@ ceres::Solver::Options ceresOptions(bool schur) {
   o.function_tolerance = kFunctionTolerance;
   o.parameter_tolerance = kParameterTolerance;
   o.gradient_tolerance = kGradientTolerance;
-  o.num_threads = 1;
+  o.num_threads = solverThreads();
   o.logging_type = ceres::SILENT;
   o.minimizer_progress_to_stdout = false;
   return o;
@@ -334,12 +347,12 @@ void registerAll() {
       Outcome o;
       for (auto _ : state) o = solveOrbis(p->scene, p->motionOnly, state);
       report(state, o);
-    })->Unit(benchmark::kMillisecond);
+    })->Unit(benchmark::kMillisecond)->UseRealTime();
     benchmark::RegisterBenchmark(("ceres/" + p->name).c_str(), [p](benchmark::State& state) {
       Outcome o;
       for (auto _ : state) o = solveCeres(p->scene, p->motionOnly, state);
       report(state, o);
-    })->Unit(benchmark::kMillisecond);
+    })->Unit(benchmark::kMillisecond)->UseRealTime();
   }
   for (const auto& [name, bal] : balCases()) {
     const BalProblem* p = bal.get();
@@ -349,12 +362,12 @@ void registerAll() {
       Outcome o;
       for (auto _ : state) o = solveOrbisBal(*p, state);
       report(state, o);
-    })->Unit(benchmark::kMillisecond);
+    })->Unit(benchmark::kMillisecond)->UseRealTime();
     benchmark::RegisterBenchmark(("ceres/" + name).c_str(), [p](benchmark::State& state) {
       Outcome o;
       for (auto _ : state) o = solveCeresBal(*p, state);
       report(state, o);
-    })->Unit(benchmark::kMillisecond);
+    })->Unit(benchmark::kMillisecond)->UseRealTime();
   }
 }
 
@@ -368,13 +381,14 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const auto slash = name.find('/');
       auto& row = rows_[name.substr(slash + 1)];
       Side& side = name.substr(0, slash) == "orbis" ? row.orbis : row.ceres;
-      side.ms = run.GetAdjustedCPUTime();
+      side.ms = solverThreads() > 1 ? run.GetAdjustedRealTime() : run.GetAdjustedCPUTime();
       side.finalCost = run.counters.at("final_cost");
       side.iterations = run.counters.at("iterations");
     }
     ConsoleReporter::ReportRuns(runs);
   }
   void printTable() const {
+    std::printf("\n%d thread(s), %s time\n", solverThreads(), solverThreads() > 1 ? "wall" : "CPU");
     std::printf("\n%-32s %11s %11s %7s %16s %16s %9s %5s %5s\n", "problem", "orbis [ms]", "ceres [ms]", "ratio",
                 "orbis final", "ceres final", "rel diff", "it_o", "it_c");
     for (const auto& [name, row] : rows_) {

@@ -1,187 +1,355 @@
-// End-to-end SLAM timing: per-frame tracking time (ORB extraction + tracking, what the caller of
-// track() waits for) over whole real sequences, in threaded (real-time) and deterministic mode.
-// Frames are decoded before the clock starts. The in-process reference is cv::ORB's
-// detectAndCompute with the same feature budget on the same frames (the bare cost of getting
-// features with OpenCV), so the ratio says how many "OpenCV extractions" one tracked frame costs.
-// The table after the benchmarks also gives the ratio to ORB-SLAM2's median tracking time on
-// TUM teddy measured on this machine class (30.5 ms, issue 7) — a fixed external figure.
-// Data: ORBIS_DATA or ../shared/datasets; an absent sequence is skipped.
-#include <benchmark/benchmark.h>
-
+// benchmarks/bench_slam — end-to-end SLAM timing per mode and per stage, as ratios to cv::ORB.
+//
+// For each shared slice and mode (RGB-D, stereo, monocular) the program alternates, --runs times:
+// cv::ORB's detectAndCompute over the sequence's (left/colour) frames on one OpenCV thread, with
+// the mode's feature budget (the in-process yardstick: what getting features costs with OpenCV on
+// this machine at this moment), then a threaded `orbis run` of the same sequence (runDataset,
+// the dataset's default budget and rate). It prints, per mode, the medians over the runs of each
+// stage's per-frame median and p95 (StageTimer, as report.json), the per-frame time as the issue
+// 35 table defines it (ORB extraction + tracking medians) and its ratio to cv::ORB's median.
+// The last column divides by ORB-SLAM2's median tracking time measured in an earlier session on
+// this machine (issue 35): a fixed external figure, not re-measured here, so it moves with the
+// machine's load while the cv::ORB ratio does not.
+// --realtime adds live-camera runs (frames fed at their timestamps, SlamOptions::liveCamera) of
+// the monocular cases: the wait for mapping after a keyframe (median, p95), keyframes, local BA
+// time, and the Sim(3)-aligned ATE and scale (estimate to ground truth).
+// Data: --data DIR, else ORBIS_DATA, else ../shared/datasets; an absent slice is skipped.
+// Usage and options: docs/guide/speed.md.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "orbis/adapters/dataset.hpp"
+#include "orbis/eval/metrics.hpp"
+#include "orbis/io/trajectory.hpp"
 #include "orbis/system/dataset_runner.hpp"
-#include "orbis/system/slam.hpp"
+#include "orbis/util/error.hpp"
 
 namespace fs = std::filesystem;
 using namespace orbis;
 
 namespace {
 
-constexpr double kOrbSlam2TeddyMedianMs = 30.5;
-
-fs::path dataRoot() {
-  if (const char* env = std::getenv("ORBIS_DATA"); env && *env) return env;
-  return ORBIS_DEFAULT_DATA_DIR;
-}
-
-struct Loaded {
-  std::unique_ptr<DatasetReader> reader;
-  std::vector<DatasetFrame> frames;
+struct Case {
+  std::string label;
+  DatasetKind kind;
+  fs::path path;
+  std::optional<SensorKind> sensor;  // empty: the dataset's own
+  int features;                      // the dataset's default budget (dataset_runner.cpp)
+  double orbSlam2Ms;                 // issue 35's ORB-SLAM2 median, 0 when not measured
+  std::optional<fs::path> settings;  // ORB-SLAM2 settings YAML, as `orbis run --settings`
 };
 
-Loaded& load(DatasetKind kind, const char* folder) {
-  static std::map<std::string, Loaded> cache;
-  auto [it, inserted] = cache.try_emplace(folder);
-  if (inserted && fs::exists(dataRoot() / folder)) {
-    it->second.reader = openDataset(kind, dataRoot() / folder);
-    for (std::size_t i = 0; i < it->second.reader->size(); ++i) {
-      DatasetFrame f = it->second.reader->frame(i);
-      const bool complete = !f.left.empty() && (kind == DatasetKind::TumRgbd ? !f.depth.empty() : !f.right.empty());
-      if (complete) it->second.frames.push_back(std::move(f));
-    }
-  }
-  return it->second;
-}
-
-struct Summary {
-  double medianMs = 0, meanMs = 0, p95Ms = 0;
+struct Options {
+  fs::path data;
+  int runs = 3;
+  bool realtime = false;
+  bool realtimeOnly = false;
+  std::vector<std::string> only;
+  std::vector<Case> extra;
+  fs::path work = fs::temp_directory_path() / "orbis_bench_slam";
 };
-std::map<std::string, Summary> gSlam, gCvOrb;
 
-Summary summarise(std::vector<double> ms) {
-  Summary s;
-  if (ms.empty()) return s;
-  std::sort(ms.begin(), ms.end());
-  s.medianMs = ms[ms.size() / 2];
-  s.p95Ms = ms[std::min(ms.size() - 1, ms.size() * 95 / 100)];
-  for (double v : ms) s.meanMs += v / static_cast<double>(ms.size());
-  return s;
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-std::shared_ptr<const OrbVocabulary> vocabulary() {
-  static auto voc = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(defaultVocabularyPath()));
-  return voc;
+double percentile95(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(v.size())))];
 }
 
-template <class Sensor>
-void runSequence(benchmark::State& state, DatasetKind kind, const char* folder, int features, double fps,
-                 bool deterministic) {
-  Loaded& data = load(kind, folder);
-  if (data.frames.empty()) {
-    state.SkipWithError((std::string(folder) + " not found under ORBIS_DATA").c_str());
-    return;
+int defaultFeatures(DatasetKind kind) {
+  switch (kind) {
+    case DatasetKind::TumRgbd: return 1000;
+    case DatasetKind::Euroc: return 1200;
+    case DatasetKind::Kitti:
+    case DatasetKind::KittiRaw: return 2000;
   }
-  // Monocular runs on the colour/left camera's pinhole of the same sequence.
-  const typename Sensor::Camera camera = [&]() -> typename Sensor::Camera {
-    if constexpr (Sensor::kKind == SensorKind::Monocular)
-      return std::visit([](const auto& c) { return pinholeOf(c); }, data.reader->camera());
-    else return std::get<typename Sensor::Camera>(data.reader->camera());
-  }();
-  OrbParams orb;
-  orb.features = features;
-  std::vector<double> perFrameMs;
-  for (auto _ : state) {
-    SlamOptions options;
-    options.deterministic = deterministic;
-    options.fps = fps;
-    Slam<Sensor> slam(camera, orb, vocabulary(), options);
-    perFrameMs.clear();
-    for (const DatasetFrame& f : data.frames) {
-      typename Sensor::Input input;
-      if constexpr (std::is_same_v<Sensor, Rgbd>) input = {f.timestamp, f.left, f.depth};
-      else if constexpr (std::is_same_v<Sensor, Monocular>) input = {f.timestamp, f.left};
-      else input = {f.timestamp, f.left, f.right};
-      const auto t0 = std::chrono::steady_clock::now();
-      slam.track(input);
-      perFrameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    }
-    slam.shutdown();
-  }
-  const Summary s = summarise(perFrameMs);
-  const std::string key = std::string(folder) + (Sensor::kKind == SensorKind::Monocular ? " mono" : "") +
-                          (deterministic ? " deterministic" : " threaded");
-  gSlam[key] = s;
-  state.counters["median_ms"] = s.medianMs;
-  state.counters["p95_ms"] = s.p95Ms;
-  state.counters["frames"] = static_cast<double>(perFrameMs.size());
+  return 1000;
 }
 
-void runCvOrb(benchmark::State& state, DatasetKind kind, const char* folder, int features) {
-  Loaded& data = load(kind, folder);
-  if (data.frames.empty()) {
-    state.SkipWithError((std::string(folder) + " not found under ORBIS_DATA").c_str());
-    return;
-  }
+std::vector<Case> sharedSlices(const fs::path& data) {
+  const auto mono = std::optional<SensorKind>(SensorKind::Monocular);
+  return {
+      {"teddy rgbd", DatasetKind::TumRgbd, data / "tum_fr3_teddy_200", std::nullopt, 1000, 15.0},
+      {"euroc stereo", DatasetKind::Euroc, data / "euroc_V1_01_easy_95", std::nullopt, 1200, 26.8},
+      {"kitti06 stereo", DatasetKind::Kitti, data / "kitti_06_first51", std::nullopt, 2000, 53.1},
+      {"kitti0102 stereo", DatasetKind::Kitti, data / "kitti_0102_first51", std::nullopt, 2000, 50.6},
+      {"teddy mono", DatasetKind::TumRgbd, data / "tum_fr3_teddy_200", mono, 1000, 12.7},
+      {"kitti06 mono", DatasetKind::Kitti, data / "kitti_06_first51", mono, 2000, 18.7},
+  };
+}
+
+// cv::ORB with ORB-SLAM's pyramid (8 levels, 1.2) and the case's budget, on one thread, per frame.
+std::vector<double> cvOrbMs(DatasetReader& reader, int features) {
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
   auto orb = cv::ORB::create(features, 1.2f, 8, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, 20);
-  std::vector<double> perFrameMs;
-  for (auto _ : state) {
-    perFrameMs.clear();
-    for (const DatasetFrame& f : data.frames) {
-      cv::Mat grey = f.left;
-      std::vector<cv::KeyPoint> keypoints;
-      cv::Mat descriptors;
-      const auto t0 = std::chrono::steady_clock::now();
-      if (grey.channels() == 3) cv::cvtColor(grey, grey, cv::COLOR_BGR2GRAY);
-      orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
-      perFrameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      benchmark::DoNotOptimize(descriptors.data);
-    }
+  std::vector<double> ms;
+  for (std::size_t i = 0; i < reader.size(); ++i) {
+    const DatasetFrame f = reader.frame(i);
+    if (f.left.empty()) continue;
+    std::vector<cv::KeyPoint> keypoints;
+    cv::Mat descriptors, grey;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (f.left.channels() == 3) cv::cvtColor(f.left, grey, cv::COLOR_BGR2GRAY);
+    else grey = f.left;
+    orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
-  gCvOrb[folder] = summarise(perFrameMs);
-  state.counters["median_ms"] = gCvOrb[folder].medianMs;
+  cv::setNumThreads(threads);
+  return ms;
 }
 
-constexpr const char* kTeddy = "tum_fr3_teddy_200";
-constexpr const char* kEuroc = "euroc_V1_01_easy_95";
-constexpr const char* kKitti = "kitti_06_first51";
+// One stage's per-run medians and p95s (over the runs of a case).
+struct StageRuns {
+  std::vector<double> median, p95;
+  std::size_t count = 0;
+};
 
-void BM_TeddyRgbdThreaded(benchmark::State& s) { runSequence<Rgbd>(s, DatasetKind::TumRgbd, kTeddy, 1000, 30, false); }
-void BM_TeddyRgbdDeterministic(benchmark::State& s) { runSequence<Rgbd>(s, DatasetKind::TumRgbd, kTeddy, 1000, 30, true); }
-void BM_TeddyMonoThreaded(benchmark::State& s) { runSequence<Monocular>(s, DatasetKind::TumRgbd, kTeddy, 1000, 30, false); }
-void BM_TeddyCvOrb(benchmark::State& s) { runCvOrb(s, DatasetKind::TumRgbd, kTeddy, 1000); }
-void BM_EurocStereoThreaded(benchmark::State& s) { runSequence<Stereo>(s, DatasetKind::Euroc, kEuroc, 1200, 20, false); }
-void BM_EurocCvOrb(benchmark::State& s) { runCvOrb(s, DatasetKind::Euroc, kEuroc, 1200); }
-void BM_KittiStereoThreaded(benchmark::State& s) { runSequence<Stereo>(s, DatasetKind::Kitti, kKitti, 2000, 10, false); }
-void BM_KittiCvOrb(benchmark::State& s) { runCvOrb(s, DatasetKind::Kitti, kKitti, 2000); }
+struct CaseResult {
+  std::vector<double> cvOrbMedian;
+  std::vector<std::string> stageOrder;
+  std::map<std::string, StageRuns> stages;
+  std::vector<double> keyFrames, ateMm, scale, seconds;
+  std::size_t frames = 0;
+};
 
-BENCHMARK(BM_TeddyCvOrb)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_TeddyRgbdThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_TeddyRgbdDeterministic)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_TeddyMonoThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_EurocCvOrb)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_EurocStereoThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_KittiCvOrb)->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK(BM_KittiStereoThreaded)->Unit(benchmark::kMillisecond)->Iterations(3);
+void addReport(CaseResult& result, const RunReport& report, const fs::path& out, DatasetReader& reader) {
+  for (const StageStats& s : report.timing) {
+    auto [it, inserted] = result.stages.try_emplace(s.stage);
+    if (inserted) result.stageOrder.push_back(s.stage);
+    it->second.median.push_back(s.medianMs);
+    it->second.p95.push_back(s.p95Ms);
+    it->second.count = s.count;
+  }
+  result.keyFrames.push_back(static_cast<double>(report.stats.keyFrames));
+  result.seconds.push_back(report.seconds);
+  result.frames = report.stats.frames;
+  if (report.ateRmse) result.ateMm.push_back(*report.ateRmse * 1000);
+  // The similarity that aligns the estimate to the ground truth: its scale is the map's unit in
+  // metres (monocular), 1 for a metric sensor up to the alignment's own error.
+  if (report.ateAlignment == "sim3" && !reader.groundTruth().empty()) {
+    try {
+      const Trajectory estimate = readTrajectory(out / "trajectory.txt", TrajectoryFormat::Tum);
+      const eval::AteResult ate = eval::computeAte(reader.groundTruth(), estimate, {eval::Alignment::Sim3, 0.02});
+      result.scale.push_back(ate.alignment.scale());
+    } catch (const Error&) {
+    }
+  }
+}
+
+double stageMedian(const CaseResult& r, const std::string& stage) {
+  const auto it = r.stages.find(stage);
+  return it == r.stages.end() ? 0 : median(it->second.median);
+}
+double stageP95(const CaseResult& r, const std::string& stage) {
+  const auto it = r.stages.find(stage);
+  return it == r.stages.end() ? 0 : median(it->second.p95);
+}
+
+void printStages(const Case& c, const CaseResult& r, bool realtime) {
+  std::printf("\n%s%s: %zu frames, %d runs, keyframes %.0f, cv::ORB median %.2f ms\n", c.label.c_str(),
+              realtime ? " (realtime)" : "", r.frames, static_cast<int>(r.keyFrames.size()), median(r.keyFrames),
+              median(r.cvOrbMedian));
+  std::printf("  %-34s %6s %9s %9s %10s\n", "stage", "count", "median", "p95", "med/cvORB");
+  const double ref = median(r.cvOrbMedian);
+  for (const std::string& name : r.stageOrder) {
+    const double m = stageMedian(r, name);
+    std::printf("  %-34s %6zu %9.3f %9.3f %10.3f\n", name.c_str(), r.stages.at(name).count, m, stageP95(r, name),
+                ref > 0 ? m / ref : 0);
+  }
+}
+
+std::string loadNow() {
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) < 0) return "?";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.2f %.2f %.2f", load[0], load[1], load[2]);
+  return buf;
+}
+
+CaseResult runCase(const Case& c, const Options& options, bool realtime) {
+  DatasetOptions datasetOptions;
+  datasetOptions.sensor = c.sensor;
+  datasetOptions.tolerateBadFrames = true;
+  CaseResult result;
+  for (int run = 0; run < options.runs; ++run) {
+    auto reader = openDataset(c.kind, c.path, datasetOptions);
+    result.cvOrbMedian.push_back(median(cvOrbMs(*reader, c.features)));
+    RunOptions run_options;
+    run_options.vocabulary = defaultVocabularyPath();
+    run_options.outDir = options.work / (c.label + (realtime ? " realtime " : " ") + std::to_string(run));
+    run_options.progress = false;
+    run_options.realtime = realtime;
+    run_options.settings = c.settings;
+    const RunReport report = runDataset(*reader, run_options);
+    addReport(result, report, run_options.outDir, *reader);
+    std::fprintf(stderr, "bench_slam: %s%s run %d: %.1f s, load %s\n", c.label.c_str(), realtime ? " realtime" : "",
+                 run + 1, report.seconds, loadNow().c_str());
+  }
+  return result;
+}
+
+bool selected(const Case& c, const Options& options) {
+  if (options.only.empty()) return true;
+  return std::any_of(options.only.begin(), options.only.end(),
+                     [&](const std::string& s) { return c.label.find(s) != std::string::npos; });
+}
+
+// --sequence KIND:PATH[:SENSOR], labelled by the folder's name.
+Case parseSequence(const std::string& spec) {
+  const auto first = spec.find(':');
+  if (first == std::string::npos) throw Error("argument --sequence", "", "expects KIND:PATH[:SENSOR], got '" + spec + "'");
+  const auto last = spec.rfind(':');
+  const DatasetKind kind = parseDatasetKind(spec.substr(0, first), "argument --sequence");
+  std::optional<SensorKind> sensor;
+  std::string path = spec.substr(first + 1);
+  if (last != first) {
+    const std::string tail = spec.substr(last + 1);
+    if (tail == "mono" || tail == "stereo" || tail == "rgbd") {
+      sensor = parseSensorKind(tail, "argument --sequence");
+      path = spec.substr(first + 1, last - first - 1);
+    }
+  }
+  if (!fs::exists(path)) throw fileError(path, "no such sequence folder (argument --sequence)");
+  std::string label = fs::path(path).filename().string();
+  if (label.empty()) label = fs::path(path).parent_path().filename().string();
+  label += sensor == SensorKind::Monocular ? " mono" : "";
+  // A folder written by `orbis synth` carries its calibration: settings.yaml, settings_mono.yaml.
+  std::optional<fs::path> settings;
+  const fs::path yaml = fs::path(path) / (sensor == SensorKind::Monocular ? "settings_mono.yaml" : "settings.yaml");
+  if (fs::exists(yaml)) settings = yaml;
+  return {label, kind, path, sensor, defaultFeatures(kind), 0, settings};
+}
+
+void usage() {
+  std::printf(
+      "bench_slam [--runs N] [--only LABEL]... [--sequence KIND:PATH[:SENSOR]]... [--realtime] [--realtime-only]\n"
+      "           [--data DIR] [--work DIR]\n"
+      "Per-mode, per-stage medians and p95 of threaded orbis runs over the shared slices, with the ratio to\n"
+      "cv::ORB's extraction measured alternately in the same process (docs/guide/speed.md).\n"
+      "  --runs N            runs per case, alternating cv::ORB and orbis (default 3)\n"
+      "  --only LABEL        only cases whose label contains LABEL (repeatable), e.g. mono, kitti06\n"
+      "  --sequence SPEC     add a sequence: KIND (tum, euroc, kitti) : PATH [: mono|stereo|rgbd]; its\n"
+      "                      settings.yaml (settings_mono.yaml for mono) is used when present\n"
+      "  --realtime          also run the monocular cases as a live camera: wait for mapping, local BA, ATE, scale\n"
+      "  --realtime-only     only the live-camera runs\n"
+      "  --data DIR          the shared datasets (default $ORBIS_DATA, else ../shared/datasets)\n"
+      "  --work DIR          scratch folder for the runs' outputs (default: the temp folder)\n");
+}
+
+Options parseArgs(int argc, char** argv) {
+  Options o;
+  if (const char* env = std::getenv("ORBIS_DATA"); env && *env) o.data = env;
+  else o.data = ORBIS_DEFAULT_DATA_DIR;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw Error("argument " + a, "", "expects a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      usage();
+      std::exit(0);
+    } else if (a == "--runs") {
+      o.runs = std::atoi(value().c_str());
+      if (o.runs < 1) throw Error("argument --runs", "", "expects a positive count");
+    } else if (a == "--only") {
+      o.only.push_back(value());
+    } else if (a == "--sequence") {
+      o.extra.push_back(parseSequence(value()));
+    } else if (a == "--realtime") {
+      o.realtime = true;
+    } else if (a == "--realtime-only") {
+      o.realtime = o.realtimeOnly = true;
+    } else if (a == "--data") {
+      o.data = value();
+    } else if (a == "--work") {
+      o.work = value();
+    } else {
+      throw Error("argument " + a, "", "unknown option (see --help)");
+    }
+  }
+  return o;
+}
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  std::printf("\nper-frame tracking time (ORB extraction + tracking), last iteration, ms\n");
-  std::printf("%-36s %8s %8s %8s %14s %14s\n", "run", "median", "mean", "p95", "/ cv::ORB med", "/ ORB-SLAM2");
-  for (const auto& [key, s] : gSlam) {
-    const std::string folder = key.substr(0, key.find(' '));
-    const auto ref = gCvOrb.find(folder);
-    const double cvRatio = ref != gCvOrb.end() && ref->second.medianMs > 0 ? s.medianMs / ref->second.medianMs : 0;
-    char external[32] = "-";
-    if (folder == kTeddy) std::snprintf(external, sizeof external, "%.2f", s.medianMs / kOrbSlam2TeddyMedianMs);
-    std::printf("%-36s %8.2f %8.2f %8.2f %14.2f %14s\n", key.c_str(), s.medianMs, s.meanMs, s.p95Ms, cvRatio, external);
+int main(int argc, char** argv) try {
+  const Options options = parseArgs(argc, argv);
+  fs::create_directories(options.work);
+  std::vector<Case> cases;
+  for (const Case& c : sharedSlices(options.data))
+    if (fs::exists(c.path)) cases.push_back(c);
+    else std::fprintf(stderr, "bench_slam: %s skipped (%s not found)\n", c.label.c_str(), c.path.c_str());
+  cases.insert(cases.end(), options.extra.begin(), options.extra.end());
+  std::erase_if(cases, [&](const Case& c) { return !selected(c, options); });
+  std::printf("bench_slam: %d runs per case, load at start %s\n", options.runs, loadNow().c_str());
+
+  struct Row {
+    Case c;
+    CaseResult r;
+  };
+  std::vector<Row> rows, live;
+  if (!options.realtimeOnly)
+    for (const Case& c : cases) {
+      rows.push_back({c, runCase(c, options, false)});
+      printStages(c, rows.back().r, false);
+    }
+  if (options.realtime)
+    for (const Case& c : cases)
+      if (c.sensor == SensorKind::Monocular) {
+        live.push_back({c, runCase(c, options, true)});
+        printStages(c, live.back().r, true);
+      }
+
+  if (!rows.empty()) {
+    std::printf("\nper-frame time, threaded (ORB extraction + tracking medians, as issue 35), median over %d runs\n",
+                options.runs);
+    std::printf("%-18s %8s %9s %9s %9s %9s %10s %12s\n", "case", "cv::ORB", "extract", "track", "frame", "frame p95",
+                "/ cv::ORB", "/ ORB-SLAM2*");
+    for (const auto& [c, r] : rows) {
+      const double cv = median(r.cvOrbMedian);
+      const double extract = stageMedian(r, "tracking: ORB extraction"), track = stageMedian(r, "tracking: total");
+      const double frame = extract + track;
+      const double frameP95 = stageP95(r, "tracking: ORB extraction") + stageP95(r, "tracking: total");
+      char external[16] = "-";
+      if (c.orbSlam2Ms > 0) std::snprintf(external, sizeof external, "%.2f", frame / c.orbSlam2Ms);
+      std::printf("%-18s %8.2f %9.2f %9.2f %9.2f %9.2f %10.3f %12s\n", c.label.c_str(), cv, extract, track, frame,
+                  frameP95, cv > 0 ? frame / cv : 0, external);
+    }
+    std::printf("* ORB-SLAM2's medians from issue 35 (an earlier session, same machine class), not re-measured.\n");
   }
-  for (const auto& [folder, s] : gCvOrb)
-    std::printf("cv::ORB detectAndCompute %-20s median %.2f ms\n", folder.c_str(), s.medianMs);
+  if (!live.empty()) {
+    std::printf("\nlive camera (--realtime), median over %d runs\n", options.runs);
+    std::printf("%-18s %5s %11s %9s %9s %11s %9s %8s\n", "case", "KFs", "wait med", "wait p95", "local BA",
+                "local BA p95", "ATE mm", "scale");
+    for (const auto& [c, r] : live) {
+      std::printf("%-18s %5.0f %11.2f %9.2f %9.2f %11.2f %9.1f %8.4f\n", c.label.c_str(), median(r.keyFrames),
+                  stageMedian(r, "tracking: wait for mapping"), stageP95(r, "tracking: wait for mapping"),
+                  stageMedian(r, "mapping: local BA"), stageP95(r, "mapping: local BA"), median(r.ateMm),
+                  median(r.scale));
+    }
+  }
+  std::printf("load at end %s\n", loadNow().c_str());
   return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "bench_slam: %s\n", e.what());
+  return 1;
 }

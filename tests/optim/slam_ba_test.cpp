@@ -92,6 +92,37 @@ TEST(OptimSlamBa, LocalBaKeepsFixedKeyframesAndRecoversFreeOnes) {
   EXPECT_LE(c.falsePositives, 0.08 * c.inliers);
 }
 
+// The solver's threads (SolverOptions::threads) share the linearisation, the Schur complement,
+// the back-substitution and the cost but keep every sum in its serial order: the same bits at
+// any thread count, on a problem large enough to be shared (more than 4096 point pairs).
+TEST(OptimSlamBa, LocalBaGivesTheSameBitsAtAnyThreadCount) {
+  bench::SlamSceneSpec spec;
+  spec.keyframes = 15;
+  spec.points = 3000;
+  spec.seed = 9;
+  const auto scene = bench::makeSlamScene(spec);
+  std::vector<std::vector<SE3d>> poses;
+  std::vector<std::vector<Eigen::Vector3d>> points;
+  std::vector<BundleAdjustmentResult> results;
+  for (int threads : {1, 2, 3}) {
+    poses.push_back(scene.initialPoses);
+    points.push_back(scene.initialPoints);
+    BundleAdjustmentOptions options;
+    options.threads = threads;
+    results.push_back(bundleAdjustment(scene.camera, poses.back(), scene.poseFixed, points.back(), scene.observations, options));
+  }
+  EXPECT_LT(results[0].refinePass.finalCost, 0.5 * results[0].robustPass.initialCost);
+  for (std::size_t t = 1; t < results.size(); ++t) {
+    EXPECT_EQ(results[t].robustPass.iterations, results[0].robustPass.iterations);
+    EXPECT_EQ(results[t].refinePass.iterations, results[0].refinePass.iterations);
+    EXPECT_EQ(std::memcmp(&results[t].refinePass.finalCost, &results[0].refinePass.finalCost, sizeof(double)), 0);
+    EXPECT_EQ(results[t].outlier, results[0].outlier);
+    for (std::size_t k = 0; k < poses[0].size(); ++k) EXPECT_TRUE(sameBits(poses[t][k], poses[0][k])) << "keyframe " << k;
+    for (std::size_t l = 0; l < points[0].size(); ++l)
+      ASSERT_EQ(std::memcmp(points[t][l].data(), points[0][l].data(), 3 * sizeof(double)), 0) << "point " << l;
+  }
+}
+
 TEST(OptimSlamBa, FullBaStopsWhenAborted) {
   bench::SlamSceneSpec spec;
   spec.keyframes = 10;

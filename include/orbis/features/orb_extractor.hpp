@@ -10,7 +10,11 @@
 // standard learned pattern on the level blurred by a 7x7 Gaussian (sigma 2). Keypoints are
 // ordered by level. The total may exceed the budget by a few (the quadtree splits four ways)
 // and falls short on images with too few corners.
-// Deterministic; not thread-safe (one extractor per image stream: buffers are reused).
+// Deterministic; not thread-safe (one extractor per image stream: buffers are reused). With
+// setParallelLevels(true) the levels after the pyramid are shared between the caller's thread
+// and one more (each level's corners, quadtree and descriptors depend on that level alone, so
+// the output is bit-identical to the serial one); for an extractor that runs alone on a frame
+// (monocular, RGB-D), not one of a stereo pair that already runs on two threads.
 #pragma once
 
 #include <array>
@@ -64,6 +68,9 @@ class OrbExtractor : public PyramidExtractorBase {
   // Keypoints wanted on each level (sums to params().features).
   std::span<const int> featuresPerLevel() const { return featuresPerLevel_; }
 
+  void setParallelLevels(bool on) { parallelLevels_ = on; }
+  bool parallelLevels() const { return parallelLevels_; }
+
  private:
   struct Corner {
     float x, y, response;
@@ -73,20 +80,28 @@ class OrbExtractor : public PyramidExtractorBase {
     int begin, end;  // range in corners_
   };
 
-  void detectCorners(const cv::Mat& level);
-  void distribute(int wanted, float minX, float minY, float maxX, float maxY);
-  void splitNode(const Node& n, Node children[4], int& count);
+  // The buffers one level's detection and selection reuse; one per thread working on levels.
+  struct LevelScratch {
+    std::vector<cv::KeyPoint> fast;
+    std::vector<Corner> corners, sorted;
+    std::vector<std::uint8_t> quadrant;
+    std::vector<Node> nodes, nextNodes;
+    std::vector<int> cellCount, selected, splittable;
+  };
+
+  void extractLevel(int l, LevelScratch& s);
+  void detectCorners(const cv::Mat& level, LevelScratch& s) const;
+  static void distribute(LevelScratch& s, int wanted, float minX, float minY, float maxX, float maxY);
+  static void splitNode(LevelScratch& s, const Node& n, Node children[4], int& count);
 
   std::vector<int> featuresPerLevel_;
   std::array<CircleRowMask, kHalfPatch + 1> circleRows_{};  // orientation circle, per row offset
   cv::Mat gray_;
   std::vector<cv::Mat> blurred_;  // per level: sizes differ, so one buffer would reallocate
-  std::vector<cv::KeyPoint> fast_;
-  std::vector<Corner> corners_, scratch_;
-  std::vector<std::uint8_t> quadrant_;
-  std::vector<Node> nodes_, nextNodes_;
-  std::vector<int> cellCount_, selected_, splittable_;
-  std::vector<Keypoint> levelKeypoints_;
+  std::array<LevelScratch, 2> scratch_;
+  std::vector<std::vector<Keypoint>> levelKeypoints_;        // per level, before concatenation
+  std::vector<std::vector<OrbDescriptor>> levelDescriptors_;
+  bool parallelLevels_ = false;
 };
 
 static_assert(FeatureExtractor<OrbExtractor>);

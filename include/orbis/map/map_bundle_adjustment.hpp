@@ -9,7 +9,9 @@
 // keyframe and point of one map of the atlas, its root fixed, and returns the optimised values without writing them:
 // the loop closer merges them through the spanning tree. Both run on the sensor's camera model and
 // robust kernel (callers pass Sensor::Camera and Sensor::RobustKernel): depth observations of an RGB-D sensor as
-// a whitened disparity, of a stereo pair as (uL, v, uR). Bodies: map_bundle_adjustment_impl.hpp.
+// a whitened disparity, of a stereo pair as (uL, v, uR). `threads` share the solver's Schur
+// complement (optim/solver_options.hpp): bit-identical results at any count.
+// Bodies: map_bundle_adjustment_impl.hpp.
 #pragma once
 
 #include <atomic>
@@ -45,7 +47,7 @@ struct LocalBundleAdjustmentStats {
 // observers fixed), on the sensor's camera and kernel; abort stops it.
 template <optim::RobustKernel Kernel, CameraModel Camera>
 LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map, KeyFrame* kf,
-                                                 std::atomic<bool>* abort);
+                                                 std::atomic<bool>* abort, int threads = 2);
 
 // The result of a full BA, applied by loop closing once it ends.
 struct FullBundleAdjustmentResult {
@@ -58,7 +60,7 @@ struct FullBundleAdjustmentResult {
 // Full BA over every keyframe and point, the first keyframe fixed.
 template <optim::RobustKernel Kernel, CameraModel Camera>
 FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
-                                                std::atomic<bool>* abort, std::uint32_t mapId = 0);
+                                                std::atomic<bool>* abort, std::uint32_t mapId = 0, int threads = 2);
 
 }  // namespace orbis
 

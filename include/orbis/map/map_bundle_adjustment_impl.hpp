@@ -89,7 +89,7 @@ optim::BundleAdjustmentResult solve(const Camera& camera, BaSnapshot& s, const o
 
 template <optim::RobustKernel Kernel, CameraModel Camera>
 LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map, KeyFrame* kf,
-                                                 std::atomic<bool>* abort) {
+                                                 std::atomic<bool>* abort, int threads) {
   using namespace map_ba_detail;
   LocalBundleAdjustmentStats stats;
   BaSnapshot s;
@@ -117,6 +117,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map,
   options.iterations = 5;
   options.refineIterations = 10;
   options.abortFlag = abort;
+  options.threads = threads;
   const optim::BundleAdjustmentResult result = solve<Kernel>(camera, s, options);
   stats.aborted = result.robustPass.termination == optim::Termination::Aborted ||
                   result.refinePass.termination == optim::Termination::Aborted;
@@ -149,7 +150,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map,
 
 template <optim::RobustKernel Kernel, CameraModel Camera>
 FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, int iterations,
-                                                std::atomic<bool>* abort, std::uint32_t mapId) {
+                                                std::atomic<bool>* abort, std::uint32_t mapId, int threads) {
   using namespace map_ba_detail;
   FullBundleAdjustmentResult result;
   BaSnapshot s;
@@ -164,6 +165,7 @@ FullBundleAdjustmentResult fullBundleAdjustment(const Camera& camera, Map& map, 
   options.iterations = iterations;
   options.refineIterations = 0;
   options.abortFlag = abort;
+  options.threads = threads;
   const optim::BundleAdjustmentResult solved = solve<Kernel>(camera, s, options);
   result.aborted = solved.robustPass.termination == optim::Termination::Aborted || (abort && abort->load());
   for (std::size_t i = 0; i < s.keyFrames.size(); ++i) result.keyFramePoses[s.keyFrames[i]->id] = s.poses[i];

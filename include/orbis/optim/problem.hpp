@@ -8,12 +8,15 @@
 // linearises with the analytic Jacobians, forms the reduced camera system
 // S = H_pp − H_pl H_ll⁻¹ H_lp (dense LLT for small systems, CHOLMOD supernodal otherwise) and
 // back-substitutes the points. Costs use Ceres' convention ½Σρ(information·‖r‖²).
-// Not thread-safe; a solve can be aborted through SolverOptions::abortFlag.
+// Not thread-safe; a solve can be aborted through SolverOptions::abortFlag. SolverOptions::threads
+// shares the Schur complement, the back-substitution and the cost between threads without
+// changing a bit of the result (problem_impl.hpp says how).
 #pragma once
 
 #include "orbis/optim/levenberg_marquardt.hpp"
 #include "orbis/optim/reduced_system.hpp"
 #include "orbis/optim/residual.hpp"
+#include "orbis/util/parallel_for.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -21,6 +24,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <tuple>
 #include <type_traits>
@@ -137,8 +141,13 @@ class Problem {
   // from here on).
   bool hasFreeVariables() const { return !freePoseIds_.empty() || !freePointIds_.empty(); }
   // Evaluates residuals and Jacobians at the current values and builds the normal equations;
-  // returns the cost.
-  double linearize();
+  // returns the cost. On several threads when the problem has only point residuals: same bits.
+  double linearize() {
+    if constexpr (kOnlyPointResiduals) {
+      if (threads_ > 1) return linearizeInParallel();
+    }
+    return linearizeSerially();
+  }
   // The largest gradient entry.
   double maxGradient() const {
     double g = 0.0;
@@ -165,7 +174,8 @@ class Problem {
       const int l = freePointIds_[k];
       candidatePoints_[l] = points_[l] + pointStep_[k];
     }
-    return evaluateCost(candidatePoses_, candidatePoints_);
+    return threads_ > 1 ? evaluateCostInParallel(candidatePoses_, candidatePoints_)
+                        : evaluateCost(candidatePoses_, candidatePoints_);
   }
   // Makes the last step the current values.
   void acceptCandidate() {
@@ -237,6 +247,32 @@ class Problem {
     return cost;
   }
 
+  // evaluateCost with the kernel values computed in chunks of records on several threads and
+  // summed in record order afterwards: the same cost to the last bit.
+  double evaluateCostInParallel(const AlignedVector<Pose>& poses, const AlignedVector<Eigen::Vector3d>& points) {
+    double cost = 0.0;
+    forEachTerm([&]<std::size_t I>() {
+      using Kernel = typename TermAt<I>::Kernel;
+      const auto& records = std::get<I>(records_);
+      std::vector<double>& rho = recordRho_[I];
+      rho.resize(records.size());
+      const int chunks = static_cast<int>((records.size() + kRecordsPerTask - 1) / kRecordsPerTask);
+      parallelFor(threads_, chunks, [&](int chunk) {
+        const std::size_t first = static_cast<std::size_t>(chunk) * kRecordsPerTask;
+        const std::size_t last = std::min(records.size(), first + kRecordsPerTask);
+        for (std::size_t e = first; e < last; ++e) {
+          const auto& rec = records[e];
+          if (!rec.active) continue;
+          const double s = rec.information * rawResidual(rec, poses, points).squaredNorm();
+          rho[e] = Kernel::evaluate(s, rec.delta2).rho;
+        }
+      });
+      for (std::size_t e = 0; e < records.size(); ++e)
+        if (records[e].active) cost += 0.5 * rho[e];
+    });
+    return cost;
+  }
+
   // Whitens r and the Jacobians, then applies the robust correction of Triggs et al. (as in
   // Ceres' Corrector) so that the Gauss–Newton model matches ρ to second order.
   template <int R, class... Jacobians>
@@ -266,6 +302,16 @@ class Problem {
   }
 
   void prepare(const SolverOptions& options);
+  double linearizeSerially();
+  double linearizeInParallel();
+  void assignColumnOwners(int owners);
+  void schurComplement(double mu, Eigen::VectorXd& rhs);
+
+  static constexpr std::size_t kRecordsPerTask = 1024;
+  static constexpr int kPointsPerTask = 256;
+  // Below this many point pairs a Schur complement is too small to share: waking a helper
+  // would cost more than it saves.
+  static constexpr std::size_t kMinPairsForThreads = 4096;
 
   AlignedVector<Pose> poses_;
   std::vector<char> poseFixed_;
@@ -291,6 +337,22 @@ class Problem {
   AlignedVector<Pose> candidatePoses_;
   AlignedVector<Eigen::Vector3d> candidatePoints_;
   double minDiagonal_ = 1e-6, maxDiagonal_ = 1e32;
+  // Threads sharing the solve, and which of them adds into each block column of the reduced
+  // system (and the right-hand side of its pose): per pair of links, whose block it is.
+  int threads_ = 1;
+  std::vector<std::uint8_t> poseOwner_;  // per free pose
+  // linearizeInParallel: every record's whitened residual and Jacobians, before they are summed.
+  template <class R>
+  struct LinearisedRecords {
+    AlignedVector<ResidualVector<R>> residual;
+    AlignedVector<PoseJacobian<R>> jPose;
+    AlignedVector<PointJacobian<R>> jPoint;
+  };
+  static constexpr bool kOnlyPointResiduals = (PointResidual<typename Terms::Residual> && ...);
+  std::tuple<LinearisedRecords<typename Terms::Residual>...> linearised_;
+  std::vector<std::uint8_t> pairOwner_, linkOwner_;
+  std::array<std::vector<double>, kNumTerms> recordRho_;
+  std::vector<double> pointDecrease_, pointDamping_, pointStepSquared_;
 };
 
 }  // namespace orbis::optim

@@ -79,6 +79,7 @@ struct BundleAdjustmentOptions {
   const std::atomic<bool>* abortFlag = nullptr;
   // Dense, sparse or automatic.
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
+  int threads = 1;  // SolverOptions::threads: the same result at any count
   // When set, receives the problem in BAL form before solving (write it with io/bal.hpp's
   // writeBal for replay with `orbis ba`).
   std::function<void(const BalProblem&)> inspectBal;
@@ -267,6 +268,7 @@ BundleAdjustmentResult bundleAdjustment(const Camera& camera, std::vector<SE3d>&
   solver.maxIterations = options.iterations;
   solver.abortFlag = options.abortFlag;
   solver.linearSolver = options.linearSolver;
+  solver.threads = options.threads;
   BundleAdjustmentResult result;
   result.robustPass = problem.solve(solver);
   result.outlier.assign(observations.size(), 0);

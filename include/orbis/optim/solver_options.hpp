@@ -44,6 +44,9 @@ struct SolverOptions {
   int denseThreshold = 400;
   // Stops the solve from another thread when set.
   const std::atomic<bool>* abortFlag = nullptr;
+  // Threads for the Schur complement, the back-substitution and the cost (util/parallel_for.hpp).
+  // Every sum keeps its serial order, so the result is bit-identical at any count.
+  int threads = 1;
 };
 
 // Why a solve stopped.

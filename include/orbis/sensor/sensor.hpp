@@ -126,6 +126,7 @@ struct Rgbd {
     // An extractor for the colour image.
     FeatureBuilder(const Camera& camera, const OrbParams& orb) : camera_(camera), metric_(camera), extractor_(orb) {
       metric_.depthScale = 1.0;
+      extractor_.setParallelLevels(true);  // one image per frame: its levels use both cores
     }
     // The frame's features.
     FrameFeatures build(const Input& in) {
@@ -170,7 +171,10 @@ struct Monocular {
    public:
     // lens: the images' distortion (zero when they are undistorted).
     FeatureBuilder(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens = {})
-        : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {}
+        : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {
+      trackingExtractor_.setParallelLevels(true);  // one image per frame: its levels use both cores
+      initialisationExtractor_.setParallelLevels(true);
+    }
     // The frame's features.
     FrameFeatures build(const Input& in) {
       return extractMonocular(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, camera_, lens_);
