@@ -95,6 +95,8 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
     if (*rgb != 0 && *rgb != 1) throw yaml.error("Camera.RGB", "expected 0 (BGR) or 1 (RGB)");
     s.rgbOrder = *rgb == 1;
   }
+  // As ORB-SLAM3's settings: images (and the intrinsics) scaled to this width before extraction.
+  if (yaml.has("Camera.newWidth")) s.newWidth = positiveInteger(yaml, "Camera.newWidth");
   if (const auto seed = yaml.optionalInteger("System.seed")) {
     if (*seed < 0) throw yaml.error("System.seed", "must not be negative");
     s.seed = static_cast<std::uint32_t>(*seed);

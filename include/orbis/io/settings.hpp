@@ -4,7 +4,7 @@
 // %YAML:1.0): Camera.fx/fy/cx/cy/k1/k2/p1/p2[/k3/width/height/fps/RGB/bf], ThDepth,
 // DepthMapFactor, ORBextractor.*, and the optional LEFT./RIGHT. rectification blocks
 // (K, D, R, P, width, height) of its EuRoC file. orbis adds two optional keys: Sensor (mono |
-// stereo | rgbd, read by parseSensorKind) and System.seed. The sensor is chosen once here, in
+// stereo | rgbd, read by parseSensorKind), System.seed and, as ORB-SLAM3 does, Camera.newWidth. The sensor is chosen once here, in
 // this order: the argument of load(), the Sensor key, else inferred as ORB-SLAM2's files imply
 // (no Camera.bf: mono; Camera.bf and DepthMapFactor: rgbd; Camera.bf only: stereo). The camera
 // is then one alternative of a std::variant; code past this boundary dispatches once with
@@ -55,6 +55,7 @@ struct Settings {
   double depthDisparitySigma = RgbdCamera<double>::kDefaultDisparitySigma;
   std::optional<StereoRectificationBlocks> rectification;  // LEFT./RIGHT. blocks, if present
   std::uint32_t seed = 0;      // System.seed: seeds every random choice of the system
+  int newWidth = 0;            // Camera.newWidth (as ORB-SLAM3): images and intrinsics scaled to it first; 0: no
 
   static Settings load(const std::filesystem::path& file);
   static Settings load(const std::filesystem::path& file, SensorKind sensor);

@@ -1,7 +1,9 @@
-// orbis/system/dataset_runner.hpp — SLAM over a whole dataset sequence, with its outputs.
+// orbis/system/dataset_runner.hpp — SLAM over a whole sequence or stream, with its outputs.
 //
-// Contract: runDataset reads the sequence frame by frame through a DatasetReader, picks the
-// compile-time sensor configuration once from the dataset's sensor (Slam<Stereo>, Slam<Rgbd> or
+// Contract: runSource reads frames one after another from a FrameSource (a dataset, a video, an
+// image folder, a live camera: adapters/frame_source.hpp); runDataset is runSource over a
+// dataset read in order. The run picks the compile-time sensor configuration once from the
+// source's sensor (Slam<Stereo>, Slam<Rgbd> or
 // Slam<Monocular>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
 // camera-to-world, every tracked frame), keyframes.txt (TUM), report.json (frame counts,
 // keyframes, map points, per-stage timing in ms: mean/median/p95, and the ATE of all frames and
@@ -9,9 +11,16 @@
 // dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
 // A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
 // later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
-// else from the dataset's own calibration. RunOptions::observer, when set, sees every frame and
+// else from the dataset's own calibration; a source without calibration and no settings file
+// throws orbis::Error saying how to get one. RunOptions::resizeWidth (or the settings key
+// Camera.newWidth) scales every image and the intrinsics together before extraction; frames of
+// another size than the settings' Camera.width/height but the same aspect scale the intrinsics
+// too (with a warning), another aspect throws. RunOptions::stopRequested (a signal flag) is
+// checked every frame: the run ends there, writes every output and marks the report
+// interrupted. A live source's dropped frames, the capture-to-pose latency of every frame
+// (median, p95) and why a source ended early go into the report. RunOptions::observer, when set, sees every frame and
 // takes map snapshots while the run lasts, and gets the final map after shutdown.
-// RunOptions::realtime feeds the frames at the rate they were recorded, as a live camera would:
+// RunOptions::realtime feeds the frames of a source that is not live at the rate they were recorded:
 // each frame no earlier than its timestamp's offset from the first frame's (on the steady clock,
 // from when the first was fed); a frame tracking is already late for is fed at once, never
 // skipped, and the run does not slow down to catch up. Without it, frames are fed as fast as
@@ -25,6 +34,7 @@
 #include <vector>
 
 #include "orbis/adapters/dataset.hpp"
+#include "orbis/adapters/frame_source.hpp"
 #include "orbis/system/slam.hpp"
 
 namespace orbis {
@@ -44,6 +54,17 @@ struct RunOptions {
   std::optional<std::filesystem::path> saveMap;  // where to save the final map
   SlamObserver* observer = nullptr;              // e.g. a live viewer (slam_observer.hpp); not owned
   bool stats = false;  // diagnosis: outDir/stats.jsonl, one line per frame and per keyframe (StageTimer events)
+  int resizeWidth = 0;  // > 0: images and intrinsics scaled to this width first (wins over Camera.newWidth)
+  std::function<bool()> stopRequested;  // true: end the run now, outputs written, report interrupted
+  // Ground truth (any trajectory format readTrajectory detects) for a source that has none, matched
+  // to the frames by timestamp (a video run with SourceOptions::timesFile gets the images' times).
+  std::optional<std::filesystem::path> groundTruth;
+};
+
+// Capture-to-pose latency of the frames tracked, milliseconds.
+struct LatencyStats {
+  std::size_t count = 0;
+  double medianMs = 0, p95Ms = 0, maxMs = 0;
 };
 
 struct RunReport {
@@ -64,8 +85,18 @@ struct RunReport {
   std::size_t relocalisationAttempts = 0, relocalisations = 0;
   // Loops closed, in order; a monocular one carries its Sim(3) scale: the scale drift it corrected.
   std::vector<LoopClosureEvent> loopClosures;
+  // The source: its name, whether it was live, frames it dropped (newest frame wins) and why it
+  // ended early (empty: it ended normally).
+  bool live = false;
+  std::size_t droppedFrames = 0;
+  std::string endReason;
+  LatencyStats latency;
+  int inputWidth = 0, inputHeight = 0;  // of the frames as delivered
+  int resizedWidth = 0, resizedHeight = 0;  // as tracked, when scaled (0: not scaled)
+  bool interrupted = false;  // RunOptions::stopRequested ended the run
 };
 
+RunReport runSource(FrameSource& source, const RunOptions& options);
 RunReport runDataset(DatasetReader& dataset, const RunOptions& options);
 
 // The vocabulary shipped with orbis: the source tree's vocabulary/ when run from a build, else

@@ -74,7 +74,10 @@ class FrameSource {
   virtual bool live() const { return false; }
   // How many frames will come, when known in advance (files, folders); a progress bar's total.
   virtual std::optional<std::size_t> expectedFrames() const { return std::nullopt; }
-  // The calibration the source carries (only a dataset's); empty: a settings file must give it.
+  // Whether the source carries its own calibration (only a dataset does), and that calibration
+  // (empty without one: a settings file must give it; a dataset's camera() may throw when its
+  // files do not say, e.g. which TUM Kinect recorded it).
+  virtual bool hasCalibration() const { return false; }
   virtual std::optional<DatasetCamera> camera() const { return std::nullopt; }
   virtual RadTanDistortion<double> distortion() const { return {}; }
   // Camera-to-world poses of the left/colour camera, when known; empty otherwise.
