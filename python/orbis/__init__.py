@@ -1,8 +1,9 @@
-"""orbis: ORB-SLAM2 visual SLAM (stereo and RGB-D) from Python, with NumPy in and out.
+"""orbis: ORB-SLAM2 visual SLAM (monocular, stereo and RGB-D) from Python, with NumPy in and out.
 
 Contract: this package is the public face of the compiled extension ``orbis._orbis``. It
 re-exports the SLAM classes, settings, vocabulary, trajectory I/O and errors at the top level,
-and groups the rest by area: ``orbis.datasets`` (TUM / EuRoC / KITTI readers), ``orbis.eval``
+and groups the rest by area: ``orbis.datasets`` (TUM / EuRoC / KITTI readers), ``orbis.sources``
+(videos, image folders, live cameras as iterators), ``orbis.eval``
 (ATE, RPE, KITTI metric, the same numbers as ``orbis eval``) and ``orbis.ba`` (BAL problems and
 the bundle-adjustment solver). Poses are 4 x 4 camera-to-world float64 matrices; trajectories
 are (N, 8) float64 arrays of TUM rows ``t x y z qx qy qz qw``.
@@ -26,6 +27,7 @@ from . import _orbis
 from ._orbis import (
     Error,
     MissingFileError,
+    MonocularSlam,
     OrbParams,
     RgbdSlam,
     Settings,
@@ -36,13 +38,14 @@ from ._orbis import (
     read_trajectory,
     write_trajectory,
 )
-from . import ba, datasets, eval  # noqa: E402  (the submodules import the names above)
+from . import ba, datasets, eval, sources  # noqa: E402  (the submodules import the names above)
 
 __version__: str = _orbis.__version__
 
 __all__ = [
     "Error",
     "MissingFileError",
+    "MonocularSlam",
     "OrbParams",
     "RgbdSlam",
     "Settings",
@@ -55,6 +58,7 @@ __all__ = [
     "extract_orb",
     "pose_matrices",
     "read_trajectory",
+    "sources",
     "write_trajectory",
     "__version__",
 ]
