@@ -144,6 +144,7 @@ class DatasetSource final : public FrameSource {
   }
   SensorKind sensor() const override { return dataset_.sensor(); }
   std::optional<std::size_t> expectedFrames() const override { return dataset_.size(); }
+  bool hasCalibration() const override { return true; }
   std::optional<DatasetCamera> camera() const override { return dataset_.camera(); }
   RadTanDistortion<double> distortion() const override { return dataset_.distortion(); }
   const Trajectory& groundTruth() const override { return dataset_.groundTruth(); }

@@ -57,6 +57,7 @@ class LiveSource final : public FrameSource {
   bool live() const override { return true; }
   std::optional<std::size_t> expectedFrames() const override { return inner_->expectedFrames(); }
   const Trajectory& groundTruth() const override { return inner_->groundTruth(); }
+  bool hasCalibration() const override { return inner_->hasCalibration(); }
   std::optional<DatasetCamera> camera() const override { return inner_->camera(); }
   RadTanDistortion<double> distortion() const override { return inner_->distortion(); }
   std::size_t dropped() const override { return dropped_.load(); }

@@ -1,8 +1,9 @@
-"""orbis: ORB-SLAM2 visual SLAM (stereo and RGB-D) from Python, with NumPy in and out.
+"""orbis: ORB-SLAM2 visual SLAM (monocular, stereo and RGB-D) from Python, with NumPy in and out.
 
 Contract: this package is the public face of the compiled extension ``orbis._orbis``. It
 re-exports the SLAM classes, settings, vocabulary, trajectory I/O and errors at the top level,
-and groups the rest by area: ``orbis.datasets`` (TUM / EuRoC / KITTI readers), ``orbis.eval``
+and groups the rest by area: ``orbis.datasets`` (TUM / EuRoC / KITTI readers), ``orbis.sources``
+(videos, image folders, live cameras as iterators), ``orbis.eval``
 (ATE, RPE, KITTI metric, the same numbers as ``orbis eval``) and ``orbis.ba`` (BAL problems and
 the bundle-adjustment solver); ``orbis.sweep`` (studies of sequences x settings x repeats on a
 Dask cluster) is imported on demand. Poses are 4 x 4 camera-to-world float64 matrices; trajectories
@@ -27,6 +28,7 @@ from . import _orbis
 from ._orbis import (
     Error,
     MissingFileError,
+    MonocularSlam,
     OrbParams,
     RgbdSlam,
     Settings,
@@ -39,13 +41,14 @@ from ._orbis import (
     settings_keys,
     write_trajectory,
 )
-from . import ba, datasets, eval  # noqa: E402  (the submodules import the names above)
+from . import ba, datasets, eval, sources  # noqa: E402  (the submodules import the names above)
 
 __version__: str = _orbis.__version__
 
 __all__ = [
     "Error",
     "MissingFileError",
+    "MonocularSlam",
     "OrbParams",
     "RgbdSlam",
     "Settings",
@@ -60,6 +63,7 @@ __all__ = [
     "pose_matrices",
     "read_trajectory",
     "settings_keys",
+    "sources",
     "write_trajectory",
     "__version__",
 ]

@@ -14,6 +14,10 @@ from typing import Any, Dict, Iterator, List, Optional, Tuple, Union, overload
 import numpy as np
 import numpy.typing as npt
 
+from . import sources as _sources
+
+sources = _sources
+
 PathLike = Union[str, "os.PathLike[str]"]
 TrajectoryLike = Union[PathLike, npt.ArrayLike]
 
@@ -181,7 +185,7 @@ class StereoSlam(_Slam):
     @overload
     def track(self, left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8], timestamp: float) -> TrackResult: ...
     @overload
-    def track(self, frame: Frame) -> TrackResult: ...
+    def track(self, frame: Union[Frame, "_sources.SourceFrame"]) -> TrackResult: ...
     def __enter__(self) -> StereoSlam: ...
 
 class RgbdSlam(_Slam):
@@ -189,8 +193,16 @@ class RgbdSlam(_Slam):
     def track(self, image: npt.NDArray[np.uint8], depth: Union[npt.NDArray[np.uint16], npt.NDArray[np.float32]],
               timestamp: float) -> TrackResult: ...
     @overload
-    def track(self, frame: Frame) -> TrackResult: ...
+    def track(self, frame: Union[Frame, "_sources.SourceFrame"]) -> TrackResult: ...
     def __enter__(self) -> RgbdSlam: ...
+
+class MonocularSlam(_Slam):
+    """Monocular: the map's scale is arbitrary; lens distortion (Camera.k1..k3) is handled."""
+    @overload
+    def track(self, image: npt.NDArray[np.uint8], timestamp: float) -> TrackResult: ...
+    @overload
+    def track(self, frame: Union[Frame, "_sources.SourceFrame"]) -> TrackResult: ...
+    def __enter__(self) -> MonocularSlam: ...
 
 # ---- evaluation -------------------------------------------------------------------------------
 

@@ -23,12 +23,13 @@ namespace py = pybind11;
 void bindErrors(py::module_& m);      // orbis.Error, orbis.MissingFileError (errors.cpp)
 void bindSettings(py::module_& m);    // Settings, OrbParams (settings.cpp)
 void bindVocabulary(py::module_& m);  // Vocabulary: load, default, train, transform (vocabulary.cpp)
-void bindSlam(py::module_& m);        // TrackingState, StereoSlam, RgbdSlam (slam.cpp)
+void bindSlam(py::module_& m);        // TrackingState, StereoSlam, RgbdSlam, MonocularSlam (slam.cpp)
 void bindDatasets(py::module_& m);    // Dataset, Frame, open_dataset (datasets.cpp)
 void bindTrajectories(py::module_& m);  // read_trajectory, write_trajectory (trajectories.cpp)
 void bindEvaluation(py::module_& m);  // ate, rpe, kitti_metric (evaluation.cpp)
 void bindBundleAdjustment(py::module_& m);  // BalProblem, solve_bal (bundle_adjustment.cpp)
 void bindCalibration(py::module_& m);  // calibrate (calibration.cpp)
+void bindSources(py::module_& m);     // sources: video, images, camera (sources.cpp)
 
 // Shared by the bindings: a sensor name ('mono', 'stereo', 'rgbd'; ValueError otherwise), and a
 // camera as a dict of its model and parameters (settings.cpp).

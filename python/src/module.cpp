@@ -7,13 +7,14 @@
 
 PYBIND11_MODULE(_orbis, m) {
   using namespace orbis::python;
-  m.doc() = "orbis: ORB-SLAM2 visual SLAM (stereo, RGB-D) from Python; see the orbis package.";
+  m.doc() = "orbis: ORB-SLAM2 visual SLAM (monocular, stereo, RGB-D) from Python; see the orbis package.";
   m.attr("__version__") = orbis::versionString();
   bindErrors(m);
   bindSettings(m);
   bindVocabulary(m);
   bindDatasets(m);
   bindTrajectories(m);
+  bindSources(m);
   bindSlam(m);
   bindEvaluation(m);
   bindBundleAdjustment(m);

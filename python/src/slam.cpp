@@ -1,9 +1,10 @@
-// python/src/slam.cpp — orbis.StereoSlam and orbis.RgbdSlam over orbis::Slam<Stereo|Rgbd>.
+// python/src/slam.cpp — orbis.StereoSlam, orbis.RgbdSlam and orbis.MonocularSlam over
+// orbis::Slam<Stereo|Rgbd|Monocular>.
 //
 // Contract: a Slam object is built from Settings (its camera must be the class's sensor) or from
 // a Dataset (its own calibration, with `orbis run`'s per-dataset ORB budget and frame rate), a
 // vocabulary (default: the shipped one) and SlamOptions given as keywords. track() takes NumPy
-// images (views, no copy) or a dataset Frame and returns (TrackingState, 4 x 4 camera-to-world
+// images (views, no copy), a dataset Frame or a source's SourceFrame and returns (TrackingState, 4 x 4 camera-to-world
 // pose or None when not tracked); the GIL is released while C++ tracks, and calls on one object
 // are serialised by its own mutex. Wrong dtype -> TypeError, wrong or mismatched shape, a
 // non-increasing timestamp, a frame without its second image -> ValueError; tracking after
@@ -21,6 +22,7 @@
 #include "bindings.hpp"
 #include "errors.hpp"
 #include "orbis/adapters/dataset.hpp"
+#include "orbis/adapters/frame_source.hpp"
 #include "orbis/system/slam.hpp"
 #include "orbis/util/error.hpp"
 #include "slam_session.hpp"
@@ -179,7 +181,33 @@ struct TrackArguments<Rgbd> {
 };
 
 template <class Sensor>
+void bindPairTrack(py::class_<SlamSession<Sensor>>& c);
+
+template <class Sensor>
 void bindTrack(py::class_<SlamSession<Sensor>>& c) {
+  if constexpr (Sensor::kKind == SensorKind::Monocular) {
+    c.def(
+         "track",
+         [](SlamSession<Sensor>& s, const py::handle& image, double timestamp) {
+           const ImageView view = imageView(image, "image");
+           return s.track(MonocularInput{timestamp, view.mat});
+         },
+         "image"_a, "timestamp"_a,
+         "Tracks one frame; returns (TrackingState, 4 x 4 float64 camera-to-world pose, or None when\n"
+         "not tracked). The image is used in place when its rows are contiguous.")
+        .def(
+            "track", [](SlamSession<Sensor>& s, const DatasetFrame& frame) { return s.track(MonocularInput{frame.timestamp, frame.left}); },
+            "frame"_a, "Tracks a dataset Frame (its image and timestamp).")
+        .def(
+            "track", [](SlamSession<Sensor>& s, const SourceFrame& frame) { return s.track(MonocularInput{frame.timestamp, frame.image}); },
+            "frame"_a, "Tracks a frame of orbis.sources (its image and timestamp).");
+  } else {
+    bindPairTrack<Sensor>(c);
+  }
+}
+
+template <class Sensor>
+void bindPairTrack(py::class_<SlamSession<Sensor>>& c) {
   using Args = TrackArguments<Sensor>;
   using Input = typename Sensor::Input;
   c.def(
@@ -199,7 +227,16 @@ void bindTrack(py::class_<SlamSession<Sensor>>& c) {
               throw py::value_error("frame " + std::to_string(frame.index) + " has no " + Args::kSecond + " image");
             return s.track(Input{frame.timestamp, frame.left, second});
           },
-          "frame"_a, "Tracks a dataset Frame (its images and timestamp).");
+          "frame"_a, "Tracks a dataset Frame (its images and timestamp).")
+      .def(
+          "track",
+          [](SlamSession<Sensor>& s, const SourceFrame& frame) {
+            const cv::Mat& second = Sensor::kKind == SensorKind::Stereo ? frame.right : frame.depth;
+            if (frame.image.empty() || second.empty())
+              throw py::value_error("frame " + std::to_string(frame.index) + " has no " + Args::kSecond + " image");
+            return s.track(Input{frame.timestamp, frame.image, second});
+          },
+          "frame"_a, "Tracks a frame of orbis.sources (its images and timestamp).");
 }
 
 // `orbis run`'s ORB budget and frame rate for a sequence without a settings file
@@ -229,7 +266,8 @@ std::unique_ptr<SlamSession<Sensor>> makeSession(const Settings& settings, std::
                           std::string(toString(Sensor::kKind)) + " (Settings.load(path, sensor=...))");
   SlamOptions o = options;
   o.fps = fps.value_or(settings.fps);
-  return std::make_unique<SlamSession<Sensor>>(*camera, settings.orb, vocabularyOrDefault(std::move(vocabulary)), o);
+  return std::make_unique<SlamSession<Sensor>>(*camera, settings.orb, vocabularyOrDefault(std::move(vocabulary)), o,
+                                               settings.distortion);
 }
 
 template <class Sensor>
@@ -245,7 +283,8 @@ std::unique_ptr<SlamSession<Sensor>> makeSession(const DatasetReader& dataset, s
   orb.features = defaults.features;
   SlamOptions o = options;
   o.fps = fps.value_or(defaults.fps);
-  return std::make_unique<SlamSession<Sensor>>(*typed, orb, vocabularyOrDefault(std::move(vocabulary)), o);
+  return std::make_unique<SlamSession<Sensor>>(*typed, orb, vocabularyOrDefault(std::move(vocabulary)), o,
+                                               dataset.distortion());
 }
 
 // One constructor: from Settings or from a Dataset (makeSession), with SlamOptions as keywords.
@@ -300,6 +339,10 @@ void bindSlam(py::module_& m) {
   bindSlamClass<Rgbd>(m, "RgbdSlam",
                       "ORB-SLAM2 on an RGB-D camera (orbis::Slam<orbis::Rgbd>).\n"
                       "track(image, depth, timestamp) or track(frame).");
+  bindSlamClass<Monocular>(m, "MonocularSlam",
+                           "ORB-SLAM2 on one camera (orbis::Slam<orbis::Monocular>): the map's scale is arbitrary.\n"
+                           "track(image, timestamp) or track(frame). Lens distortion (Camera.k1..k3) is undistorted\n"
+                           "at the keypoints, as `orbis run --sensor mono` does.");
 }
 
 }  // namespace orbis::python

@@ -26,18 +26,19 @@ namespace orbis::python {
 
 namespace py = pybind11;
 
-inline std::array<const cv::Mat*, 2> inputImages(const StereoInput& in) { return {&in.left, &in.right}; }
-inline std::array<const cv::Mat*, 2> inputImages(const RgbdInput& in) { return {&in.image, &in.depth}; }
+inline std::vector<const cv::Mat*> inputImages(const StereoInput& in) { return {&in.left, &in.right}; }
+inline std::vector<const cv::Mat*> inputImages(const RgbdInput& in) { return {&in.image, &in.depth}; }
+inline std::vector<const cv::Mat*> inputImages(const MonocularInput& in) { return {&in.image}; }
 
 template <class Sensor>
 class SlamSession {
  public:
   using Camera = typename Sensor::Camera;
 
+  // lens: the distortion still in a monocular camera's images (stereo and RGB-D images arrive rectified).
   SlamSession(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
-              const SlamOptions& options)
-      : camera_(camera), localisationOnly_(options.localisationOnly),
-        slam_(std::make_unique<Slam<Sensor>>(camera, orb, std::move(vocabulary), options)) {}
+              const SlamOptions& options, const RadTanDistortion<double>& lens = {})
+      : camera_(camera), localisationOnly_(options.localisationOnly), slam_(makeSlam(camera, orb, lens, std::move(vocabulary), options)) {}
 
   ~SlamSession() {
     if (PyGILState_Check()) {
@@ -92,8 +93,15 @@ class SlamSession {
   const Camera& camera() const { return camera_; }
 
  private:
+  static std::unique_ptr<Slam<Sensor>> makeSlam(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
+                                                std::shared_ptr<const OrbVocabulary> vocabulary, const SlamOptions& options) {
+    if constexpr (Sensor::kKind == SensorKind::Monocular)
+      return std::make_unique<Slam<Sensor>>(camera, orb, lens, std::move(vocabulary), options);
+    else return std::make_unique<Slam<Sensor>>(camera, orb, std::move(vocabulary), options);
+  }
+
   void checkSize(const typename Sensor::Input& input) const {
-    const cv::Size expected(camera_.pinhole.width, camera_.pinhole.height);
+    const cv::Size expected(pinholeOf(camera_).width, pinholeOf(camera_).height);
     for (const cv::Mat* image : inputImages(input)) {
       if (expected.width > 0 && expected.height > 0 && image->size() != expected)
         throw py::value_error("image of " + std::to_string(image->cols) + " x " + std::to_string(image->rows) +

@@ -1,10 +1,12 @@
-// orbis run: SLAM on a dataset sequence (TUM RGB-D, EuRoC, KITTI layouts).
+// orbis run: SLAM on a dataset sequence (TUM RGB-D, EuRoC, KITTI layouts), a video, an image
+// folder or a live camera.
 #include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <memory>
 
 #include "command.hpp"
+#include "run_sources.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
@@ -25,12 +27,12 @@ void createOutputFolder(const std::filesystem::path& dir) {
 }
 
 // A run that tracked nothing has failed, whatever it wrote: say why, and exit non-zero.
-void requireSomethingTracked(const DatasetReader& dataset, const RunReport& r) {
-  const std::string root = dataset.root().string();
-  if (dataset.size() == 0) throw Error(root, "", "the sequence lists no frame: nothing to run");
+void requireSomethingTracked(const std::string& root, std::optional<std::size_t> frames, const RunReport& r) {
+  if (frames && *frames == 0) throw Error(root, "", "the sequence lists no frame: nothing to run");
+  if (r.stats.frames == 0 && !r.endReason.empty()) throw Error(root, "", "no frame processed: " + r.endReason);
   if (r.stats.frames == 0)
-    throw Error(root, "", "none of the " + std::to_string(dataset.size()) +
-                              " frames could be processed (every one was skipped; the warnings above say why)");
+    throw Error(root, "", "none of the " + (frames ? std::to_string(*frames) + " " : std::string()) +
+                              "frames could be processed (every one was skipped; the warnings above say why)");
   if (r.stats.tracked == 0)
     throw Error(root, "", "none of the " + std::to_string(r.stats.frames) +
                               " frames processed was tracked: check the camera calibration (--settings FILE), "
@@ -57,13 +59,17 @@ int viewerPort(const ArgParser& p) {
 
 int runCommand(const std::vector<std::string>& rawArgs) {
   const std::vector<std::string> args = withViewerPort(rawArgs);
-  ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic] [--realtime]",
-              "Runs SLAM over a dataset sequence and writes DIR/trajectory.txt, keyframes.txt, report.json,\n"
-              "map.ply and overview.png. Stereo sequences (EuRoC, KITTI) run as stereo, TUM as RGB-D.\n"
-              "kitti-raw PATH is a raw drive folder (image_00, image_01, oxts) with the calib_*.txt files beside it.");
-  p.positional("DATASET", "tum, euroc, kitti or kitti-raw (the on-disk layout)")
-      .positional("PATH", "the sequence folder")
-      .option("--settings", "FILE", "ORB-SLAM2 settings YAML (camera, ORBextractor.*); default: the dataset's calibration")
+  ArgParser p("orbis run tum|euroc|kitti|kitti-raw PATH | video FILE|URL | images DIR | camera [N|/dev/videoN|PIPELINE]\n"
+              "           [--settings FILE] [--vocab FILE] [--out DIR] [--deterministic] [--realtime]",
+              "Runs SLAM over a dataset sequence, a video, an image folder or a live camera and writes\n"
+              "DIR/trajectory.txt, keyframes.txt, report.json, map.ply and overview.png. Stereo sequences\n"
+              "(EuRoC, KITTI) run as stereo, TUM as RGB-D; videos, folders and cameras as monocular unless\n"
+              "--stereo, --right or --depth say otherwise, and need --settings (their camera's calibration).\n"
+              "kitti-raw PATH is a raw drive folder (image_00, image_01, oxts) with the calib_*.txt files beside it.\n"
+              "Ctrl-C ends a run cleanly: every output is written, the report marked interrupted, exit status 130.");
+  p.positional("DATASET", "tum, euroc, kitti or kitti-raw (the on-disk layout), or video, images or camera")
+      .positional("PATH", "the sequence folder; the video file, URL or GStreamer pipeline; the image folder; the camera (index, /dev/videoN or pipeline, default 0)", false)
+      .option("--settings", "FILE", "ORB-SLAM2 settings YAML (camera, ORBextractor.*); default: the dataset's calibration (required for video, images and camera)")
       .option("--vocab", "FILE", "vocabulary (orbis binary); default: the shipped one")
       .option("--out", "DIR", "output folder", "out")
       .option("--sensor", "KIND", "read the dataset as mono, stereo or rgbd (default: its own sensor)")
@@ -80,15 +86,41 @@ int runCommand(const std::vector<std::string>& rawArgs) {
       .option("--new-map-after", "FRAMES:SECONDS", "start a new map once relocalisation failed on FRAMES frames spanning SECONDS", "10:0.3")
       .flag("--json", "print the report as JSON on standard output")
       .flag("--stats", "write DIR/stats.jsonl: per-frame tracking and per-keyframe mapping counters (diagnosis)")
+      .option("--fps", "HZ", "video, images, camera: the frame rate that times the frames (frame i at i/HZ; overrides a video's own times)")
+      .option("--times", "FILE", "video, images: one timestamp per frame (first column; seconds or nanoseconds), e.g. the rgb.txt the frames came from")
+      .option("--groundtruth", "FILE", "a trajectory (TUM, KITTI or EuRoC) to compute the ATE against, matched to the frames by timestamp")
+      .option("--resize", "WIDTH", "scale every image and the intrinsics to this width before extraction (default: Camera.newWidth, else none)")
+      .option("--stereo", "PACKING", "video, images, camera: each frame holds both views, side-by-side or top-bottom")
+      .option("--right", "PATH", "video, images: the right camera's video or folder (stereo from two sources, frame i with frame i)")
+      .option("--depth", "DIR", "images: the depth folder (16-bit PNG) paired with the colour folder PATH by timestamp (RGB-D)")
+      .option("--stall", "SECONDS", "a live source that delivers nothing for this long ends the run", "5")
       .option("--viewer", "[PORT]", "serve a live view of the run at http://127.0.0.1:PORT/ (default port 8080)")
       .flag("--viewer-wait", "with --viewer: keep serving the finished run until Ctrl-C");
   if (!p.parse(args)) return 0;
-  DatasetOptions datasetOptions;
-  datasetOptions.tolerateBadFrames = true;  // a bad frame is reported and skipped, not the end of the run
-  if (auto s = p.getOptional("--sequence")) datasetOptions.kittiSequence = *s;
-  if (auto s = p.getOptional("--sensor")) datasetOptions.sensor = parseSensorKind(*s, "argument --sensor");
-  auto dataset = openDataset(parseDatasetKind(p.pos(0), "argument DATASET"), p.pos(1), datasetOptions);
+  const bool stream = isStreamSourceKind(p.pos(0));
+  std::unique_ptr<DatasetReader> dataset;
+  std::unique_ptr<FrameSource> source;
+  if (stream) {
+    source = openStreamSource(p.pos(0), p);
+  } else {
+    const DatasetKind kind = parseDatasetKind(p.pos(0), "argument DATASET");
+    if (p.positionalCount() < 2) throw Error("arguments", "", "missing PATH\nusage: orbis run " + p.pos(0) + " PATH [options]");
+    for (const char* streamOnly : {"--fps", "--times", "--stereo", "--right", "--depth"})
+      if (p.has(streamOnly))
+        throw Error(std::string("argument ") + streamOnly, "", "applies to video, images and camera, not to a dataset");
+    DatasetOptions datasetOptions;
+    datasetOptions.tolerateBadFrames = true;  // a bad frame is reported and skipped, not the end of the run
+    if (auto s = p.getOptional("--sequence")) datasetOptions.kittiSequence = *s;
+    if (auto s = p.getOptional("--sensor")) datasetOptions.sensor = parseSensorKind(*s, "argument --sensor");
+    dataset = openDataset(kind, p.pos(1), datasetOptions);
+  }
   RunOptions options;
+  if (auto g = p.getOptional("--groundtruth")) options.groundTruth = *g;
+  if (p.has("--resize")) {
+    const long width = p.getInt("--resize");
+    if (width < 16) throw Error("argument --resize", "", "expects a width of at least 16 pixels");
+    options.resizeWidth = static_cast<int>(width);
+  }
   if (auto s = p.getOptional("--settings")) options.settings = *s;
   options.vocabulary = p.has("--vocab") ? std::filesystem::path(p.get("--vocab")) : defaultVocabularyPath();
   options.outDir = p.get("--out");
@@ -129,7 +161,9 @@ int runCommand(const std::vector<std::string>& rawArgs) {
 #else
   if (p.has("--viewer")) throw Error("argument --viewer", "", "this orbis was built without the viewer (ORBIS_BUILD_VIEWER)");
 #endif
-  const RunReport r = runDataset(*dataset, options);
+  catchInterrupts();
+  options.stopRequested = [] { return interruptRequested(); };
+  const RunReport r = dataset ? runDataset(*dataset, options) : runSource(*source, options);
   printReport(r, options, p.has("--json"));
 #ifdef ORBIS_HAS_VIEWER
   if (viewer) {
@@ -142,7 +176,13 @@ int runCommand(const std::vector<std::string>& rawArgs) {
     waitUntilInterrupted();
   }
 #endif
-  requireSomethingTracked(*dataset, r);
+  if (r.interrupted) {
+    std::fprintf(stderr, "interrupted: the outputs computed so far are in %s\n", options.outDir.string().c_str());
+    return 130;
+  }
+  if (dataset) requireSomethingTracked(dataset->root().string(), dataset->size(), r);
+  else requireSomethingTracked(source->name(), std::nullopt, r);
+  if (!r.endReason.empty()) std::fprintf(stderr, "warning: the source ended early: %s\n", r.endReason.c_str());
   return 0;
 }
 
@@ -174,6 +214,14 @@ void printReport(const RunReport& r, const RunOptions& options, bool json) {
                 !r.loadedMapMetricScale ? "" : *r.loadedMapMetricScale ? " (metric scale)" : " (scale arbitrary)");
   if (options.denseCloud && r.densePoints)
     std::printf("dense cloud    %zu points in %s\n", r.densePoints, options.denseCloud->string().c_str());
+  if (r.live || r.droppedFrames)
+    std::printf("live           %zu frames dropped (newest frame wins)\n", r.droppedFrames);
+  if (r.latency.count)
+    std::printf("latency        median %.1f ms, p95 %.1f ms (capture to pose, %zu tracked frames)\n", r.latency.medianMs,
+                r.latency.p95Ms, r.latency.count);
+  if (r.resizedWidth)
+    std::printf("resized        %dx%d -> %dx%d\n", r.inputWidth, r.inputHeight, r.resizedWidth, r.resizedHeight);
+  if (r.interrupted) std::printf("interrupted    by a signal: outputs hold what was computed until then\n");
   if (r.ateRmse)
     std::printf("ATE (%s)     %.4f m RMSE over %zu poses (path %.2f m, %.2f%%)\n", r.ateAlignment == "sim3" ? "Sim3" : "SE3 ",
                 *r.ateRmse, r.ateMatched, r.pathLength, r.pathLength > 0 ? 100 * *r.ateRmse / r.pathLength : 0.0);
@@ -187,7 +235,7 @@ void printReport(const RunReport& r, const RunOptions& options, bool json) {
               options.outDir.string().c_str());
 }
 
-ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI odometry and raw)", runCommand);
+ORBIS_REGISTER_COMMAND("run", "SLAM on a dataset (TUM RGB-D, EuRoC, KITTI odometry and raw), a video, an image folder or a camera", runCommand);
 
 }  // namespace
 }  // namespace orbis::cli

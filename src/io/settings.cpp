@@ -27,6 +27,7 @@ constexpr SettingsKey kSettingsKeys[] = {
     {"Camera.width", "whole number", "image width (optional: taken from the first image)"},
     {"Camera.height", "whole number", "image height (optional: taken from the first image)"},
     {"Camera.fps", "number", "frame rate (optional, 0 or absent: 30)"},
+    {"Camera.newWidth", "whole number", "scale images and intrinsics to this width before extraction (ORB-SLAM3; --resize wins)"},
     {"Camera.bf", "number", "stereo baseline times fx (stereo and rgbd)"},
     {"Camera.RGB", "whole number", "1: colour images are RGB, 0: BGR"},
     {"Camera.type", "text", "lens model: PinHole (default) or KannalaBrandt8 (fisheye, ORB-SLAM3)"},
@@ -200,6 +201,8 @@ Settings loadSettings(const std::filesystem::path& file, std::optional<SensorKin
     if (*rgb != 0 && *rgb != 1) throw yaml.error("Camera.RGB", "expected 0 (BGR) or 1 (RGB)");
     s.rgbOrder = *rgb == 1;
   }
+  // As ORB-SLAM3's settings: images (and the intrinsics) scaled to this width before extraction.
+  if (yaml.has("Camera.newWidth")) s.newWidth = positiveInteger(yaml, "Camera.newWidth");
   if (const auto seed = yaml.optionalInteger("System.seed")) {
     if (*seed < 0) throw yaml.error("System.seed", "must not be negative");
     s.seed = static_cast<std::uint32_t>(*seed);

@@ -1,11 +1,14 @@
 #include "orbis/system/dataset_runner.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <thread>
 
+#include "frame_preparation.hpp"
 #include "orbis/eval/metrics.hpp"
 #include "orbis/io/dense_cloud.hpp"
 #include "orbis/io/overview.hpp"
@@ -110,6 +113,19 @@ void writeReport(const fs::path& file, const RunReport& r) {
   for (const auto& [reason, frames] : r.stats.initialisationWaits) w.field(reason, frames);
   w.endObject().endObject();
   w.field("seconds", r.seconds);
+  w.field("interrupted", r.interrupted);
+  // Where the frames came from, what the source lost and how late the poses were.
+  w.key("source").beginObject().field("name", r.dataset).field("live", r.live).field("dropped_frames", r.droppedFrames);
+  w.key("end_reason");
+  if (r.endReason.empty()) w.null();
+  else w.value(r.endReason);
+  w.key("input_size").beginArray().value(r.inputWidth).value(r.inputHeight).endArray();
+  w.key("resized_to");
+  if (r.resizedWidth) w.beginArray().value(r.resizedWidth).value(r.resizedHeight).endArray();
+  else w.null();
+  w.endObject();
+  w.key("latency_ms").beginObject().field("count", r.latency.count).field("median", r.latency.medianMs);
+  w.field("p95", r.latency.p95Ms).field("max", r.latency.maxMs).endObject();
   w.field("keyframes_loaded", r.keyFramesLoaded);
   if (r.loadedMapMetricScale) w.field("loaded_map_scale", *r.loadedMapMetricScale ? "metric" : "arbitrary");
   w.field("dense_points", r.densePoints);
@@ -153,23 +169,43 @@ void writeReport(const fs::path& file, const RunReport& r) {
 }
 
 template <class Sensor>
-typename Sensor::Input makeInput(const DatasetFrame& f);
+typename Sensor::Input makeInput(const SourceFrame& f);
 
 template <>
-StereoInput makeInput<Stereo>(const DatasetFrame& f) {
-  return {f.timestamp, f.left, f.right};
+StereoInput makeInput<Stereo>(const SourceFrame& f) {
+  return {f.timestamp, f.image, f.right};
 }
 template <>
-RgbdInput makeInput<Rgbd>(const DatasetFrame& f) {
-  return {f.timestamp, f.left, f.depth};
+RgbdInput makeInput<Rgbd>(const SourceFrame& f) {
+  return {f.timestamp, f.image, f.depth};
 }
 template <>
-MonocularInput makeInput<Monocular>(const DatasetFrame& f) {
-  return {f.timestamp, f.left};
+MonocularInput makeInput<Monocular>(const SourceFrame& f) {
+  return {f.timestamp, f.image};
 }
 template <>
-MonocularInput makeInput<MonocularFisheye>(const DatasetFrame& f) {
-  return {f.timestamp, f.left};
+MonocularInput makeInput<MonocularFisheye>(const SourceFrame& f) {
+  return {f.timestamp, f.image};
+}
+
+LatencyStats latencyStats(std::vector<double> ms) {
+  LatencyStats s;
+  s.count = ms.size();
+  if (ms.empty()) return s;
+  std::sort(ms.begin(), ms.end());
+  const auto at = [&](double q) { return ms[static_cast<std::size_t>(std::min<double>(ms.size() - 1, std::floor(q * (ms.size() - 1) + 0.5)))]; };
+  s.medianMs = at(0.5);
+  s.p95Ms = at(0.95);
+  s.maxMs = ms.back();
+  return s;
+}
+
+// The status line of a run: frames, state, fps, dropped frames, keyframes, map points.
+std::string statusText(TrackingState state, double fps, std::size_t dropped, const SlamStats& stats) {
+  char text[160];
+  std::snprintf(text, sizeof text, "%s %.1f fps, %zu dropped, %zu keyframes, %zu points", toString(state), fps, dropped,
+                stats.keyFrames, stats.mapPoints);
+  return text;
 }
 
 bool inputComplete(const StereoInput& in) { return !in.left.empty() && !in.right.empty(); }
@@ -190,6 +226,7 @@ Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& or
 class FramePacer {
  public:
   explicit FramePacer(bool enabled) : enabled_(enabled) {}
+  bool enabled() const { return enabled_; }
   void waitUntilDue(double timestamp) {
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
@@ -211,20 +248,31 @@ class FramePacer {
   std::chrono::steady_clock::time_point firstFed_;
 };
 
+// What runWith needs of the run besides the camera: the source, the frame already read to
+// size the camera, and the scaling decided from it.
+struct RunInput {
+  FrameSource& source;
+  std::optional<SourceFrame> first;
+  run_detail::FrameScaling scaling;
+  const Trajectory* groundTruth = nullptr;
+  std::size_t pulled = 0;  // frames taken from the source before the run (unreadable ones)
+  std::shared_ptr<const OrbVocabulary> vocabulary;
+};
+
 template <class Sensor, class Lens>
 void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbParams& orb,
-             double fps, DatasetReader& dataset, const RunOptions& options, RunReport& report) {
-  auto vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
+             double fps, RunInput& in, const RunOptions& options, RunReport& report) {
+  FrameSource& source = in.source;
   SlamOptions slamOptions;
   slamOptions.deterministic = options.deterministic;
   slamOptions.localisationOnly = options.localisationOnly;
   slamOptions.loopClosing = options.loopClosing;
   slamOptions.fps = fps;
-  slamOptions.liveCamera = options.realtime;
+  slamOptions.liveCamera = options.realtime || source.live();
   slamOptions.atlas = options.atlas;
   slamOptions.newMapAfterLostFrames = options.newMapAfterLostFrames;
   slamOptions.newMapAfterLostSeconds = options.newMapAfterLostSeconds;
-  Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, vocabulary, slamOptions);
+  Slam<Sensor> slam = makeSlam<Sensor>(camera, orb, lens, in.vocabulary, slamOptions);
   slam.core().timer().enableEvents(options.stats);
   if (options.loadMap) {
     report.loadedMapMetricScale = slam.core().loadMap(*options.loadMap).metricScale;
@@ -235,9 +283,10 @@ void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbP
     options.observer->attach([&slam] { return slam.mapSnapshot(); });
   }
 
-  for (const auto& w : dataset.warnings()) report.warnings.push_back(w);
-  const std::size_t n = options.maxFrames ? std::min(options.maxFrames, dataset.size()) : dataset.size();
-  ProgressBar bar("orbis run", n, options.progress);
+  const std::optional<std::size_t> expected = source.expectedFrames();
+  const std::size_t n = options.maxFrames ? (expected ? std::min(options.maxFrames, *expected) : options.maxFrames)
+                                          : expected.value_or(0);
+  ProgressBar bar("orbis run", n, options.progress);  // without a total: a status line
   const auto start = std::chrono::steady_clock::now();
   double lastTimestamp = -std::numeric_limits<double>::infinity();
   // --dense: the images of every frame that became a keyframe, by timestamp (the reader loads
@@ -247,42 +296,75 @@ void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbP
   if (options.denseCloud && !Sensor::kDepthFromSensor)
     report.warnings.push_back("--dense needs an RGB-D sequence: no dense cloud written");
   std::exception_ptr failure;
-  FramePacer pacer(options.realtime);
+  FramePacer pacer(options.realtime && !source.live());  // a live source keeps its own time
+  std::vector<double> latencyMs;
+  std::string status;
+  auto lastStatus = start - std::chrono::seconds(1);
+  std::size_t pulled = in.pulled, processed = 0;
   try {
-    for (std::size_t i = 0; i < n; ++i) {
-      DatasetFrame frame;
-      try {
-        frame = dataset.frame(i);
-      } catch (const Error& e) {
-        report.warnings.push_back(std::string("frame ") + std::to_string(i) + " skipped: " + e.what());
-        continue;
+    while (!options.maxFrames || pulled < options.maxFrames) {
+      if (options.stopRequested && options.stopRequested()) {
+        report.interrupted = true;
+        break;
       }
-      if (!(frame.timestamp > lastTimestamp)) {
+      std::optional<SourceFrame> frame;
+      if (in.first) {
+        frame = std::move(in.first);
+        in.first.reset();
+      } else {
+        try {
+          frame = source.next();
+        } catch (const Error& e) {
+          report.warnings.push_back(std::string("frame ") + std::to_string(pulled++) + " skipped: " + e.what());
+          continue;
+        }
+      }
+      if (!frame) {
+        if (options.stopRequested && options.stopRequested()) report.interrupted = true;
+        break;
+      }
+      ++pulled;
+      const std::size_t i = frame->index;
+      if (!(frame->timestamp > lastTimestamp)) {
         report.warnings.push_back("frame " + std::to_string(i) + " skipped: timestamp " +
-                                  std::to_string(frame.timestamp) + " does not increase");
+                                  std::to_string(frame->timestamp) + " does not increase");
         continue;
       }
-      const auto input = makeInput<Sensor>(frame);
+      if (!run_detail::applyScaling(*frame, in.scaling)) {
+        report.warnings.push_back("frame " + std::to_string(i) + " skipped: " + std::to_string(frame->image.cols) + "x" +
+                                  std::to_string(frame->image.rows) + " is not the first frame's size");
+        continue;
+      }
+      const auto input = makeInput<Sensor>(*frame);
       if (!inputComplete(input)) {  // one warning per skipped frame: the reader's reason, if it gave one
         report.warnings.push_back("frame " + std::to_string(i) + " skipped: " +
-                                  (frame.warnings.empty() ? "incomplete input" : frame.warnings.front()));
+                                  (frame->warnings.empty() ? "incomplete input" : frame->warnings.front()));
         continue;
       }
-      for (const auto& w : frame.warnings) report.warnings.push_back("frame " + std::to_string(i) + ": " + w);
-      lastTimestamp = frame.timestamp;
-      pacer.waitUntilDue(frame.timestamp);  // after reading: loading the images is not the camera's delay
+      for (const auto& w : frame->warnings) report.warnings.push_back("frame " + std::to_string(i) + ": " + w);
+      lastTimestamp = frame->timestamp;
+      pacer.waitUntilDue(frame->timestamp);  // after reading: loading the images is not the camera's delay
+      const auto fed = pacer.enabled() ? std::chrono::steady_clock::now() : frame->captured;
       const TrackResult r = slam.track(input);
+      const auto now = std::chrono::steady_clock::now();
+      ++processed;
+      if (r.state == TrackingState::Ok) latencyMs.push_back(std::chrono::duration<double, std::milli>(now - fed).count());
       if constexpr (Sensor::kDepthFromSensor) {
-        if (options.denseCloud && r.newKeyFrame) keyFrameImages[frame.timestamp] = {input.depth, input.image};
+        if (options.denseCloud && r.newKeyFrame) keyFrameImages[frame->timestamp] = {input.depth, input.image};
       }
-      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      char status[64];
-      std::snprintf(status, sizeof status, "%s %.1f fps", toString(r.state), secs > 0 ? (i + 1) / secs : 0.0);
-      bar.update(i + 1, status);
+      if (bar.enabled() && now - lastStatus > std::chrono::milliseconds(250)) {
+        lastStatus = now;
+        const double secs = std::chrono::duration<double>(now - start).count();
+        status = statusText(r.state, secs > 0 ? processed / secs : 0.0, source.dropped(), slam.stats());
+      }
+      bar.update(pulled, status);
     }
   } catch (...) {
     failure = std::current_exception();  // outputs computed so far are still written below
   }
+  report.droppedFrames = source.dropped();
+  report.endReason = source.endReason();
+  report.latency = latencyStats(std::move(latencyMs));
   bar.finish();
   slam.shutdown();
   if (options.observer) options.observer->detach(slam.mapSnapshot());
@@ -328,7 +410,7 @@ void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbP
   scene.estimate = trajectory;
   scene.keyFrames = keyFrames;
   scene.mapPoints = cloud;
-  const Trajectory& gt = dataset.groundTruth();
+  const Trajectory& gt = *in.groundTruth;
   if (!gt.empty() && !trajectory.empty()) {
     try {
       // A monocular map's scale is arbitrary: its trajectory is compared up to a similarity.
@@ -384,25 +466,35 @@ void runWith(const typename Sensor::Camera& camera, const Lens& lens, const OrbP
 
 }  // namespace
 
-RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
+namespace {
+
+// The calibration of a source without a settings file: its own, or an error saying how to get one.
+DatasetCamera sourceCamera(const FrameSource& source) {
+  if (source.hasCalibration())
+    if (auto camera = source.camera()) return *camera;
+  throw Error(source.name(), "",
+              "has no calibration: pass --settings FILE, an ORB-SLAM2 settings YAML with Camera.fx/fy/cx/cy "
+              "and k1/k2/p1/p2 (examples/settings/ holds some), or measure your camera with "
+              "`orbis calibrate` (docs/guide/own-camera.md)");
+}
+
+RunReport runFrames(FrameSource& source, const RunOptions& options, const Defaults& defaults) {
   RunReport report;
-  report.dataset = std::string(toString(dataset.kind())) + ":" + dataset.root().filename().string();
-  const Defaults defaults = datasetDefaults(dataset.kind());
+  report.dataset = source.name();
+  report.live = source.live();
   OrbParams orb;
   orb.features = defaults.features;
   double fps = defaults.fps;
   DatasetCamera camera;
   RadTanDistortion<double> lens;
+  std::optional<KannalaBrandtCamera<double>> fisheye;  // settings with Camera.type KannalaBrandt8
+  int resizeWidth = options.resizeWidth;
+  std::string calibrationSource = source.name();
   if (options.settings) {
-    const Settings s = Settings::load(*options.settings, dataset.sensor());
+    const Settings s = Settings::load(*options.settings, source.sensor());
     orb = s.orb;
     fps = s.fps;
-    if (const auto* fisheye = std::get_if<KannalaBrandtCamera<double>>(&s.camera)) {
-      // Settings pick the instantiation once: a monocular Kannala-Brandt lens (settings.hpp).
-      report.sensor = std::string(toString(dataset.sensor())) + " (fisheye)";
-      runWith<MonocularFisheye>(MonocularFisheye::planeOf(*fisheye), *fisheye, orb, fps, dataset, options, report);
-      return report;
-    }
+    if (const auto* kb = std::get_if<KannalaBrandtCamera<double>>(&s.camera)) fisheye = *kb;
     camera = std::visit(
         [](const auto& c) -> DatasetCamera {
           if constexpr (std::is_same_v<std::decay_t<decltype(c)>, KannalaBrandtCamera<double>>) return c.centralPinhole();
@@ -410,24 +502,75 @@ RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
         },
         s.camera);
     lens = s.distortion;
+    if (resizeWidth <= 0) resizeWidth = s.newWidth;
+    calibrationSource = options.settings->string();
   } else {
-    camera = dataset.camera();
-    lens = dataset.distortion();
+    camera = sourceCamera(source);
+    lens = source.distortion();
   }
-  report.sensor = std::string(toString(dataset.sensor()));
+  if (options.stopRequested) source.setCancelCheck(options.stopRequested);
+  report.sensor = std::string(toString(source.sensor()));
+  for (const auto& w : source.warnings()) report.warnings.push_back(w);
+  Trajectory groundTruth = source.groundTruth();
+  if (options.groundTruth) groundTruth = readTrajectory(*options.groundTruth, detectTrajectoryFormat(*options.groundTruth));
+
+  // The first frame that reads sizes the camera (a bad one is skipped as any other would be).
+  // The vocabulary loads first: a live source starts capturing with that read, and the first
+  // frame should not wait for the load.
+  RunInput in{source, std::nullopt, {}, &groundTruth};
+  in.vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
+  while (!in.first && !(options.stopRequested && options.stopRequested())) {
+    try {
+      in.first = source.next();
+      if (!in.first) break;
+    } catch (const Error& e) {
+      report.warnings.push_back(std::string("frame ") + std::to_string(in.pulled++) + " skipped: " + e.what());
+    }
+  }
+  if (in.first) {
+    in.scaling = run_detail::planScaling(camera, in.first->image.cols, in.first->image.rows, resizeWidth,
+                                         calibrationSource, !source.hasCalibration(), report.warnings);
+    report.inputWidth = in.scaling.inputWidth;
+    report.inputHeight = in.scaling.inputHeight;
+    if (in.scaling.imageScale != 1.0) {
+      report.resizedWidth = in.scaling.width;
+      report.resizedHeight = in.scaling.height;
+    }
+  }
+  if (fisheye) {
+    // Settings pick the instantiation once: a monocular Kannala-Brandt lens (settings.hpp). Its
+    // intrinsics are not rescaled, so the frames must come at the calibrated size.
+    if (in.scaling.imageScale != 1.0)
+      throw Error(calibrationSource, "key Camera.type",
+                  "a KannalaBrandt8 camera runs at its calibrated image size: drop --resize / Camera.newWidth, or "
+                  "calibrate the camera at the size the frames come in");
+    report.sensor += " (fisheye)";
+    runWith<MonocularFisheye>(MonocularFisheye::planeOf(*fisheye), *fisheye, orb, fps, in, options, report);
+    return report;
+  }
   std::visit(
       [&](const auto& cam) {
         using C = std::decay_t<decltype(cam)>;
         if constexpr (std::is_same_v<C, RectifiedStereoCamera<double>>) {
-          runWith<Stereo>(cam, lens, orb, fps, dataset, options, report);
+          runWith<Stereo>(cam, lens, orb, fps, in, options, report);
         } else if constexpr (std::is_same_v<C, RgbdCamera<double>>) {
-          runWith<Rgbd>(cam, lens, orb, fps, dataset, options, report);
+          runWith<Rgbd>(cam, lens, orb, fps, in, options, report);
         } else {
           static_assert(std::is_same_v<C, PinholeCamera<double>>);
-          runWith<Monocular>(cam, lens, orb, fps, dataset, options, report);
+          runWith<Monocular>(cam, lens, orb, fps, in, options, report);
         }
       },
       camera);
+  return report;
+}
+
+}  // namespace
+
+RunReport runSource(FrameSource& source, const RunOptions& options) { return runFrames(source, options, {1000, 30}); }
+
+RunReport runDataset(DatasetReader& dataset, const RunOptions& options) {
+  const auto source = makeDatasetSource(dataset);
+  RunReport report = runFrames(*source, options, datasetDefaults(dataset.kind()));
   return report;
 }
 

@@ -4,7 +4,7 @@
 // %YAML:1.0): Camera.fx/fy/cx/cy/k1/k2/p1/p2[/k3/width/height/fps/RGB/bf], ThDepth,
 // DepthMapFactor, ORBextractor.*, and the optional LEFT./RIGHT. rectification blocks
 // (K, D, R, P, width, height) of its EuRoC file. orbis adds two optional keys: Sensor (mono |
-// stereo | rgbd, read by parseSensorKind) and System.seed. ORB-SLAM3's Camera.type picks the lens:
+// stereo | rgbd, read by parseSensorKind), System.seed and, as ORB-SLAM3 does, Camera.newWidth. ORB-SLAM3's Camera.type picks the lens:
 // PinHole (the default) or KannalaBrandt8, an equidistant fisheye (KannalaBrandtCamera) whose
 // fx, fy, cx, cy, k1..k4 are read from Camera.* or, in ORB-SLAM3's File.version 1.0 layout, from
 // Camera1.*; Camera.maxAngle (orbis, degrees, optional) bounds the angles off axis it is trusted
@@ -79,6 +79,7 @@ struct Settings {
   double depthDisparitySigma = RgbdCamera<double>::kDefaultDisparitySigma;
   std::optional<StereoRectificationBlocks> rectification;  // LEFT./RIGHT. blocks, if present
   std::uint32_t seed = 0;      // System.seed: seeds every random choice of the system
+  int newWidth = 0;            // Camera.newWidth (as ORB-SLAM3): images and intrinsics scaled to it first; 0: no
 
   // Reads file, choosing the sensor from its Sensor key or its keys; throws orbis::Error naming the
   // file and key.

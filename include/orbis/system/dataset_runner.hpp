@@ -1,7 +1,9 @@
-// orbis/system/dataset_runner.hpp — SLAM over a whole dataset sequence, with its outputs.
+// orbis/system/dataset_runner.hpp — SLAM over a whole sequence or stream, with its outputs.
 //
-// Contract: runDataset reads the sequence frame by frame through a DatasetReader, picks the
-// compile-time sensor configuration once from the dataset's sensor (Slam<Stereo>, Slam<Rgbd> or
+// Contract: runSource reads frames one after another from a FrameSource (a dataset, a video, an
+// image folder, a live camera: adapters/frame_source.hpp); runDataset is runSource over a
+// dataset read in order. The run picks the compile-time sensor configuration once from the
+// source's sensor (Slam<Stereo>, Slam<Rgbd> or
 // Slam<Monocular>), tracks every frame and writes, into options.outDir: trajectory.txt (TUM,
 // camera-to-world, every tracked frame), trajectory_maps.txt (per line of it: timestamp, the
 // map it was tracked in, the map holding it now), keyframes.txt (TUM), report.json (frame counts,
@@ -10,9 +12,16 @@
 // dense cloud back-projected from the final keyframes' depth maps (RunOptions::denseCloud).
 // A frame that cannot be read or tracked is reported and survived; outputs computed so far are still written if a
 // later frame throws. The camera comes from the settings file when given (ORB-SLAM2 YAML),
-// else from the dataset's own calibration. RunOptions::observer, when set, sees every frame and
+// else from the dataset's own calibration; a source without calibration and no settings file
+// throws orbis::Error saying how to get one. RunOptions::resizeWidth (or the settings key
+// Camera.newWidth) scales every image and the intrinsics together before extraction; frames of
+// another size than the settings' Camera.width/height but the same aspect scale the intrinsics
+// too (with a warning), another aspect throws. RunOptions::stopRequested (a signal flag) is
+// checked every frame: the run ends there, writes every output and marks the report
+// interrupted. A live source's dropped frames, the capture-to-pose latency of every frame
+// (median, p95) and why a source ended early go into the report. RunOptions::observer, when set, sees every frame and
 // takes map snapshots while the run lasts, and gets the final map after shutdown.
-// RunOptions::realtime feeds the frames at the rate they were recorded, as a live camera would:
+// RunOptions::realtime feeds the frames of a source that is not live at the rate they were recorded:
 // each frame no earlier than its timestamp's offset from the first frame's (on the steady clock,
 // from when the first was fed); a frame tracking is already late for is fed at once, never
 // skipped, and the run does not slow down to catch up. Without it, frames are fed as fast as
@@ -26,6 +35,7 @@
 #include <vector>
 
 #include "orbis/adapters/dataset.hpp"
+#include "orbis/adapters/frame_source.hpp"
 #include "orbis/system/slam.hpp"
 
 namespace orbis {
@@ -58,6 +68,21 @@ struct RunOptions {
   bool atlas = true;
   int newMapAfterLostFrames = 10;
   double newMapAfterLostSeconds = 0.3;
+  // @}
+  int resizeWidth = 0;  // > 0: images and intrinsics scaled to this width first (wins over Camera.newWidth)
+  std::function<bool()> stopRequested;  // true: end the run now, outputs written, report interrupted
+  // Ground truth (any trajectory format readTrajectory detects) for a source that has none, matched
+  // to the frames by timestamp (a video run with SourceOptions::timesFile gets the images' times).
+  std::optional<std::filesystem::path> groundTruth;
+};
+
+// Capture-to-pose latency of the frames tracked, milliseconds.
+struct LatencyStats {
+  // Frames measured.
+  std::size_t count = 0;
+  // @{
+  // Median, 95th percentile and largest latency.
+  double medianMs = 0, p95Ms = 0, maxMs = 0;
   // @}
 };
 
@@ -99,10 +124,24 @@ struct RunReport {
   std::vector<MapMergeEvent> merges;
   std::vector<std::uint32_t> frameMaps;
   // @}
+  // @{
+  // The source: whether it was live, frames it dropped (newest frame wins), why it ended early
+  // (empty: it ended normally) and the capture-to-pose latency.
+  bool live = false;
+  std::size_t droppedFrames = 0;
+  std::string endReason;
+  LatencyStats latency;
+  // @}
+  int inputWidth = 0, inputHeight = 0;  // of the frames as delivered
+  int resizedWidth = 0, resizedHeight = 0;  // as tracked, when scaled (0: not scaled)
+  bool interrupted = false;  // RunOptions::stopRequested ended the run
 };
 
-// Runs SLAM over the whole sequence and writes trajectory.txt, keyframes.txt, report.json, map.ply
-// and overview.png into options.outDir (and stats.jsonl, the dense cloud and the map when asked).
+// Runs SLAM over the frames of any source (a dataset, a video, an image folder, a live camera) and
+// writes trajectory.txt, keyframes.txt, report.json, map.ply and overview.png into options.outDir
+// (and stats.jsonl, the dense cloud and the map when asked).
+RunReport runSource(FrameSource& source, const RunOptions& options);
+// Runs SLAM over a dataset read in order (runSource over makeDatasetSource).
 RunReport runDataset(DatasetReader& dataset, const RunOptions& options);
 
 // The vocabulary shipped with orbis: the source tree's vocabulary/ when run from a build, else

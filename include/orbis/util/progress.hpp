@@ -2,6 +2,7 @@
 //
 // Contract: draws to stderr only when stderr is a terminal (so logs and --json output stay
 // clean); update() is cheap to call every item and redraws at most ~10 times per second.
+// Without a total (0: a live stream), it is a status line: the count, the time and the status.
 #pragma once
 
 #include <chrono>
@@ -26,8 +27,15 @@ class ProgressBar {
   void update(std::size_t done, const std::string& status = {}) {
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
-    if (done < total_ && now - lastDraw_ < std::chrono::milliseconds(100)) return;
+    if ((total_ == 0 || done < total_) && now - lastDraw_ < std::chrono::milliseconds(100)) return;
     lastDraw_ = now;
+    if (total_ == 0) {
+      const double secs = std::chrono::duration<double>(now - start_).count();
+      std::fprintf(stderr, "\r%s %zu frames %.1fs %s\x1b[K", label_.c_str(), done, secs, status.c_str());
+      std::fflush(stderr);
+      drawn_ = true;
+      return;
+    }
     const double frac = total_ ? static_cast<double>(done) / static_cast<double>(total_) : 1.0;
     const int width = 30;
     const int filled = static_cast<int>(frac * width + 0.5);
@@ -39,6 +47,8 @@ class ProgressBar {
     std::fflush(stderr);
     drawn_ = true;
   }
+  // Whether the bar draws at all.
+  bool enabled() const { return enabled_; }
   // Ends the bar's line (also done by the destructor).
   void finish() {
     if (enabled_ && drawn_) {

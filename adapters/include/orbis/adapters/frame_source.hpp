@@ -83,7 +83,10 @@ class FrameSource {
   // @}
   // How many frames will come, when known in advance (files, folders); a progress bar's total.
   virtual std::optional<std::size_t> expectedFrames() const { return std::nullopt; }
-  // The calibration the source carries (only a dataset's); empty: a settings file must give it.
+  // Whether the source carries its own calibration (only a dataset does), and that calibration
+  // (empty without one: a settings file must give it; a dataset's camera() may throw when its
+  // files do not say, e.g. which TUM Kinect recorded it).
+  virtual bool hasCalibration() const { return false; }
   virtual std::optional<DatasetCamera> camera() const { return std::nullopt; }
   // Lens distortion still present in the images (zero: undistorted or unknown).
   virtual RadTanDistortion<double> distortion() const { return {}; }
