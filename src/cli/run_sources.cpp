@@ -46,21 +46,22 @@ std::unique_ptr<FrameSource> openStreamSource(const std::string& kind, const Arg
     throw Error("arguments", "", std::string("missing PATH: the ") + (kind == "video" ? "video file or URL" : "image folder"));
   const std::string path = hasPath ? p.pos(1) : "0";
   const SourceOptions options = sourceOptions(p);
-  const std::optional<SensorKind> sensor =
-      p.has("--sensor") ? std::optional(parseSensorKind(p.get("--sensor"), "argument --sensor")) : std::nullopt;
+  // A plain flag and value rather than an optional: GCC 12 warns (wrongly) of an uninitialised optional.
+  const bool sensorGiven = p.has("--sensor");
+  const SensorKind sensor = sensorGiven ? parseSensorKind(p.get("--sensor"), "argument --sensor") : SensorKind::Monocular;
   std::unique_ptr<FrameSource> source;
   if (auto depth = p.getOptional("--depth")) {
     if (kind != "images") throw Error("argument --depth", "", "pairs colour and depth image folders: use it with `orbis run images`");
-    if (sensor && *sensor != SensorKind::Rgbd) throw Error("argument --depth", "", "needs --sensor rgbd (or no --sensor)");
+    if (sensorGiven && sensor != SensorKind::Rgbd) throw Error("argument --depth", "", "needs --sensor rgbd (or no --sensor)");
     source = openRgbdFolderSource(path, *depth, options);
   } else if (auto right = p.getOptional("--right")) {
     if (options.stereo != StereoPacking::None) throw Error("argument --right", "", "cannot be combined with --stereo");
-    if (sensor && *sensor != SensorKind::Stereo) throw Error("argument --right", "", "needs --sensor stereo (or no --sensor)");
+    if (sensorGiven && sensor != SensorKind::Stereo) throw Error("argument --right", "", "needs --sensor stereo (or no --sensor)");
     source = makeStereoPairSource(openOne(kind, path, options), openOne(kind, *right, options));
   } else {
-    if (sensor == SensorKind::Stereo && options.stereo == StereoPacking::None)
+    if (sensorGiven && sensor == SensorKind::Stereo && options.stereo == StereoPacking::None)
       throw Error("argument --sensor", "", "stereo from one source needs --stereo side-by-side|top-bottom, or a second source with --right");
-    if (sensor == SensorKind::Rgbd) throw Error("argument --sensor", "", "rgbd needs a depth folder: --depth DIR");
+    if (sensorGiven && sensor == SensorKind::Rgbd) throw Error("argument --sensor", "", "rgbd needs a depth folder: --depth DIR");
     source = openOne(kind, path, options);
   }
   // A recording played as a live camera: at its own pace, and what tracking is late for is dropped.

@@ -517,7 +517,7 @@ RunReport runFrames(FrameSource& source, const RunOptions& options, const Defaul
   // The first frame that reads sizes the camera (a bad one is skipped as any other would be).
   // The vocabulary loads first: a live source starts capturing with that read, and the first
   // frame should not wait for the load.
-  RunInput in{source, std::nullopt, {}, &groundTruth};
+  RunInput in{source, std::nullopt, {}, &groundTruth, 0, nullptr};
   in.vocabulary = std::make_shared<const OrbVocabulary>(OrbVocabulary::load(options.vocabulary));
   while (!in.first && !(options.stopRequested && options.stopRequested())) {
     try {

@@ -67,9 +67,9 @@ class OrbExtractor : public PyramidExtractorBase {
 
   // Keypoints wanted on each level (sums to params().features).
   std::span<const int> featuresPerLevel() const { return featuresPerLevel_; }
-
+  // Extract one image's pyramid levels on two threads (the same keypoints and descriptors either way).
   void setParallelLevels(bool on) { parallelLevels_ = on; }
-  bool parallelLevels() const { return parallelLevels_; }
+  /** Whether setParallelLevels(true) is in force. */ bool parallelLevels() const { return parallelLevels_; }
 
  private:
   struct Corner {

@@ -126,14 +126,14 @@ struct RunReport {
   // @}
   // @{
   // The source: whether it was live, frames it dropped (newest frame wins), why it ended early
-  // (empty: it ended normally) and the capture-to-pose latency.
+  // (empty: it ended normally), the capture-to-pose latency, and the frame sizes delivered and tracked.
   bool live = false;
   std::size_t droppedFrames = 0;
   std::string endReason;
   LatencyStats latency;
-  // @}
   int inputWidth = 0, inputHeight = 0;  // of the frames as delivered
   int resizedWidth = 0, resizedHeight = 0;  // as tracked, when scaled (0: not scaled)
+  // @}
   bool interrupted = false;  // RunOptions::stopRequested ended the run
 };
 

@@ -106,7 +106,7 @@ class HelperPool {
 };
 
 }  // namespace parallel_detail
-
+// Runs f(task) for task in [0, tasks) on up to `threads` threads of the shared pool; returns when all ran.
 template <class F>
 void parallelFor(int threads, int tasks, F&& f) {
   if (threads > 1 && tasks > 1) {

@@ -87,7 +87,7 @@ class FrameSource {
   // (empty without one: a settings file must give it; a dataset's camera() may throw when its
   // files do not say, e.g. which TUM Kinect recorded it).
   virtual bool hasCalibration() const { return false; }
-  virtual std::optional<DatasetCamera> camera() const { return std::nullopt; }
+  /** That calibration, if any. */ virtual std::optional<DatasetCamera> camera() const { return std::nullopt; }
   // Lens distortion still present in the images (zero: undistorted or unknown).
   virtual RadTanDistortion<double> distortion() const { return {}; }
   // Camera-to-world poses of the left/colour camera, when known; empty otherwise.
