@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "orbis/features/orb_params.hpp"
+#include "orbis/io/image_file.hpp"
 #include "orbis/util/atomic_file.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
@@ -34,16 +35,6 @@ void writeText(const fs::path& file, const std::string& text) {
     if (ec) throw fileError(file.parent_path().string(), "cannot create folder: " + ec.message());
   }
   writeFileAtomically(file, std::span<const char>(text.data(), text.size()));
-}
-
-void writeImage(const fs::path& file, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(file.string(), image);
-  } catch (const cv::Exception& e) {
-    throw fileError(file.string(), std::string("cannot write image: ") + e.what());
-  }
-  if (!ok) throw fileError(file.string(), "cannot write image");
 }
 
 cv::Mat cameraMatrix(const CalibratedCamera& c) { return (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1); }
@@ -156,8 +147,8 @@ void writeCalibrationReport(const fs::path& folder, const CalibrationResult& r, 
   char caption[200];
   std::snprintf(caption, sizeof caption, "%s: %d views, RMS %.3f px", toString(c.model), r.viewsUsed, r.rms);
   cv::putText(coverage, caption, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  writeImage(folder / "coverage.png", coverage);
-  if (!preview.empty()) writeImage(folder / "undistorted.png", undistortToPinhole(c, preview));
+  writeImageFile(folder / "coverage.png", coverage);
+  if (!preview.empty()) writeImageFile(folder / "undistorted.png", undistortToPinhole(c, preview));
 }
 
 }  // namespace orbis::calibration

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "orbis/calibration/calibration_output.hpp"
+#include "orbis/io/image_file.hpp"
 #include "orbis/synth/rng.hpp"
 #include "orbis/util/error.hpp"
 
@@ -168,7 +169,7 @@ fs::path writeCalibrationViews(const fs::path& outDir, const std::vector<Rendere
   for (std::size_t i = 0; i < views.size(); ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "view_%03zu.png", i);
-    if (!cv::imwrite((images / name).string(), views[i].image)) throw fileError((images / name).string(), "cannot write image");
+    writeImageFile(images / name, views[i].image);
     const Eigen::Matrix<double, 3, 4> m = views[i].cameraFromBoard.matrix3x4();
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) {

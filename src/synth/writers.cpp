@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "orbis/features/orb_params.hpp"
+#include "orbis/io/image_file.hpp"
 #include "orbis/io/trajectory.hpp"
 #include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"
@@ -64,16 +65,6 @@ void makeDirectories(const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw fileError(dir.string(), "cannot create directory: " + ec.message());
-}
-
-void writeImage(const fs::path& file, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(file.string(), image);
-  } catch (const cv::Exception& e) {
-    throw fileError(file.string(), std::string("cannot write image: ") + e.what());
-  }
-  if (!ok) throw fileError(file.string(), "cannot write image");
 }
 
 // Depth in metres to TUM's 16-bit PNG (factor 5000); out of range or invalid becomes 0.
@@ -224,22 +215,22 @@ SynthWriteResult writeSynthSequence(SyntheticSequence& seq, SynthLayout layout, 
     switch (layout) {
       case SynthLayout::Tum:
         std::snprintf(name, sizeof name, "%.6f.png", t);
-        writeImage(leftDir / name, frame.left);
-        writeImage(depthDir / name, tumDepth(frame.depth));
+        writeImageFile(leftDir / name, frame.left);
+        writeImageFile(depthDir / name, tumDepth(frame.depth));
         leftIndex.push_back(name);
         groundTruth.push_back({t, frame.pose});
         break;
       case SynthLayout::Euroc:
         std::snprintf(name, sizeof name, "%lld.png", static_cast<long long>(frame.timestampNs));
-        writeImage(leftDir / name, frame.left);
-        writeImage(rightDir / name, frame.right);
+        writeImageFile(leftDir / name, frame.left);
+        writeImageFile(rightDir / name, frame.right);
         leftIndex.push_back(name);
         groundTruth.push_back({t, frame.pose});
         break;
       case SynthLayout::Kitti:
         std::snprintf(name, sizeof name, "%06d.png", i);
-        writeImage(leftDir / name, frame.left);
-        writeImage(rightDir / name, frame.right);
+        writeImageFile(leftDir / name, frame.left);
+        writeImageFile(rightDir / name, frame.right);
         groundTruth.push_back({t - seq.timestamp(0), firstInverse * frame.pose});
         break;
     }
