@@ -5,6 +5,7 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <Eigen/Cholesky>
@@ -327,6 +328,33 @@ Fit fitModel(LensModel model, const std::vector<std::vector<cv::Point3f>>& objec
   return fit;
 }
 
+// How much the board's depth varies across a view, relative to its mean depth, from the
+// homography of the board plane onto the undistorted image plane: its third row is
+// (r13, r23, tz) up to scale whatever the focal length, so this needs no trust in the fitted
+// intrinsics. Zero for a board square-on to the camera: then focal length and distance trade
+// off exactly and the set is degenerate (Zhang's method needs foreshortened boards).
+double depthSpread(const CalibratedCamera& camera, const std::vector<cv::Point3f>& object,
+                   const std::vector<cv::Point2f>& image) {
+  const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  std::vector<cv::Point2f> normalised;
+  if (camera.model == LensModel::Fisheye)
+    cv::fisheye::undistortPoints(image, normalised, K, cv::Vec4d(camera.distortion[0], camera.distortion[1],
+                                                                 camera.distortion[2], camera.distortion[3]));
+  else
+    cv::undistortPoints(image, normalised, K, camera.distortion);
+  std::vector<cv::Point2f> plane;
+  for (const cv::Point3f& p : object) plane.emplace_back(p.x, p.y);
+  const cv::Mat H = cv::findHomography(plane, normalised);
+  if (H.empty()) return 0;
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest, sum = 0;
+  for (const cv::Point3f& p : object) {
+    const double w = H.at<double>(2, 0) * p.x + H.at<double>(2, 1) * p.y + H.at<double>(2, 2);
+    lowest = std::min(lowest, w), highest = std::max(highest, w), sum += w;
+  }
+  const double mean = sum / static_cast<double>(object.size());
+  return std::abs(mean) > 0 ? (highest - lowest) / std::abs(mean) : 0;
+}
+
 SE3d poseOf(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
   cv::Matx33d R;
   cv::Rodrigues(rvec, R);
@@ -460,7 +488,22 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, const Cal
     selected = inliers;
   }
   // 4. A set that does not pin the focal length or principal point down is degenerate: the board
-  // never tilted (Zhang's method needs planes in different orientations), or the uncertainty says so.
+  // square-on in every view (focal length and distance trade off; OpenCV's σ need not show it,
+  // docs/notes/2026-11-26-fisheye.md), all boards parallel (Zhang's method needs planes in
+  // different orientations), or the uncertainty says so.
+  double widestSpread = 0;
+  for (std::size_t v = 0; v < object.size(); ++v)
+    widestSpread = std::max(widestSpread, depthSpread(fit.camera, object[v], image[v]));
+  if (widestSpread < options.minDepthSpread) {
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "the views do not determine the camera (a degenerate set): the board is square-on to the camera "
+                  "in every view (its near and far corners differ in distance by at most %.1f%%), so the focal "
+                  "length cannot be told from the distance. Tilt the board by 20-45 degrees in several directions "
+                  "(left, right, up, down), at several distances and in every part of the image",
+                  100 * widestSpread);
+    throw Error(source, "", text);
+  }
   double widestTurn = 0;
   for (std::size_t a = 0; a < fit.rvecs.size(); ++a)
     for (std::size_t b = a + 1; b < fit.rvecs.size(); ++b) {

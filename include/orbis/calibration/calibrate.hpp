@@ -21,6 +21,7 @@
 // Every input it cannot use throws orbis::Error naming `source` and saying what to do: no view
 // shows the pattern, fewer than minViews usable views, views of different sizes, a fit that
 // fails or leaves the focal length or principal point unobservable (a degenerate set: the board
+// square-on to the camera in every view (depth across it varying under minDepthSpread), the board
 // planes of all views within minTiltDegrees of each other, or σ of the focal length or principal
 // point beyond the options' bounds).
 #pragma once
@@ -115,6 +116,9 @@ struct CalibrationOptions {
   double maxPrincipalPointSigma = 0.05;
   // Refused as degenerate when no two views' board planes differ in orientation by this much.
   double minTiltDegrees = 5.0;
+  // Refused as degenerate when in no view the board's depth varies across it by this share of its
+  // distance (a board square-on in every view: focal length and distance are interchangeable).
+  double minDepthSpread = 0.03;
 };
 
 // What became of one input view.
