@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Geometry>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "orbis/calibration/stereo_calibrate.hpp"
 #include "orbis/features/orb_params.hpp"
 #include "orbis/io/image_file.hpp"
 #include "orbis/util/atomic_file.hpp"
@@ -37,12 +39,22 @@ void writeText(const fs::path& file, const std::string& text) {
   writeFileAtomically(file, std::span<const char>(text.data(), text.size()));
 }
 
+// The settings' common tail: frame rate, colour order and ORB-SLAM2's extractor at orbis's defaults.
+std::string frameRateAndExtractor(double fps) {
+  const OrbParams orb;
+  std::string y = "Camera.fps: " + real(fps) + "\n# Colour order of the images (0: BGR, 1: RGB).\nCamera.RGB: 1\n\n";
+  y += "ORBextractor.nFeatures: " + std::to_string(orb.features) + "\n";
+  y += "ORBextractor.scaleFactor: " + real(std::round(orb.scaleFactor * 1e6) / 1e6) + "\n";
+  y += "ORBextractor.nLevels: " + std::to_string(orb.levels) + "\nORBextractor.iniThFAST: " +
+       std::to_string(orb.iniThFast) + "\nORBextractor.minThFAST: " + std::to_string(orb.minThFast) + "\n";
+  return y;
+}
+
 cv::Mat cameraMatrix(const CalibratedCamera& c) { return (cv::Mat_<double>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1); }
 
 }  // namespace
 
 void writeCalibrationSettings(const fs::path& file, const CalibratedCamera& c, double fps) {
-  const OrbParams orb;
   std::string y = "%YAML:1.0\n# Written by orbis calibrate: ORB-SLAM2 settings keys";
   y += c.model == LensModel::Fisheye ? " (ORB-SLAM3's for the fisheye).\n" : ".\n";
   y += "Sensor: \"mono\"\n\n";
@@ -60,11 +72,7 @@ void writeCalibrationSettings(const fs::path& file, const CalibratedCamera& c, d
          "\n\n";
   }
   y += "Camera.width: " + std::to_string(c.width) + "\nCamera.height: " + std::to_string(c.height) + "\n\n";
-  y += "Camera.fps: " + real(fps) + "\n# Colour order of the images (0: BGR, 1: RGB).\nCamera.RGB: 1\n\n";
-  y += "ORBextractor.nFeatures: " + std::to_string(orb.features) + "\n";
-  y += "ORBextractor.scaleFactor: " + real(std::round(orb.scaleFactor * 1e6) / 1e6) + "\n";
-  y += "ORBextractor.nLevels: " + std::to_string(orb.levels) + "\nORBextractor.iniThFAST: " +
-       std::to_string(orb.iniThFast) + "\nORBextractor.minThFAST: " + std::to_string(orb.minThFast) + "\n";
+  y += frameRateAndExtractor(fps);
   writeText(file, y);
 }
 
@@ -87,11 +95,13 @@ cv::Mat undistortToPinhole(const CalibratedCamera& c, const cv::Mat& image, Pinh
   return out;
 }
 
-std::string calibrationJson(const CalibrationResult& r, const CalibrationPattern& pattern, const fs::path& settings) {
+namespace {
+
+// The keys of one camera's calibration, into an open JSON object.
+void writeCameraFields(JsonWriter& w, const CalibrationResult& r, const CalibrationPattern& pattern,
+                       const fs::path& settings) {
   const CalibratedCamera& c = r.camera;
-  JsonWriter w;
-  w.beginObject()
-      .field("model", toString(c.model))
+  w.field("model", toString(c.model))
       .field("pattern", pattern.describe())
       .field("width", c.width)
       .field("height", c.height)
@@ -125,6 +135,14 @@ std::string calibrationJson(const CalibrationResult& r, const CalibrationPattern
   w.key("warnings").beginArray();
   for (const std::string& s : r.warnings) w.value(s);
   w.endArray();
+}
+
+}  // namespace
+
+std::string calibrationJson(const CalibrationResult& r, const CalibrationPattern& pattern, const fs::path& settings) {
+  JsonWriter w;
+  w.beginObject();
+  writeCameraFields(w, r, pattern, settings);
   w.endObject();
   return w.str();
 }
@@ -149,6 +167,101 @@ void writeCalibrationReport(const fs::path& folder, const CalibrationResult& r, 
   cv::putText(coverage, caption, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   writeImageFile(folder / "coverage.png", coverage);
   if (!preview.empty()) writeImageFile(folder / "undistorted.png", undistortToPinhole(c, preview));
+}
+
+// --- stereo -------------------------------------------------------------------------------------
+
+namespace {
+
+// An OpenCV-style matrix entry of a settings file.
+std::string yamlMatrix(const std::string& key, const Eigen::MatrixXd& m) {
+  std::string y = key + ": !!opencv-matrix\n   rows: " + std::to_string(m.rows()) + "\n   cols: " +
+                  std::to_string(m.cols()) + "\n   dt: d\n   data: [";
+  for (Eigen::Index r = 0; r < m.rows(); ++r)
+    for (Eigen::Index c = 0; c < m.cols(); ++c) y += (r + c > 0 ? ", " : "") + real(m(r, c));
+  return y + "]\n";
+}
+
+std::string rectificationBlock(const std::string& prefix, const RectificationBlock& b) {
+  std::string y = prefix + "height: " + std::to_string(b.height) + "\n" + prefix + "width: " + std::to_string(b.width) + "\n";
+  if (b.fisheye) {
+    y += "# Kannala-Brandt equidistant fisheye: D holds k1 k2 k3 k4.\n" + prefix + "type: \"KannalaBrandt8\"\n";
+    y += yamlMatrix(prefix + "D", Eigen::RowVector4d((*b.fisheye)[0], (*b.fisheye)[1], (*b.fisheye)[2], (*b.fisheye)[3]));
+  } else {
+    Eigen::Matrix<double, 1, 5> d;
+    d << b.D.k1, b.D.k2, b.D.p1, b.D.p2, b.D.k3;
+    y += yamlMatrix(prefix + "D", d);
+  }
+  return y + yamlMatrix(prefix + "K", b.K) + yamlMatrix(prefix + "R", b.R) + yamlMatrix(prefix + "P", b.P) + "\n";
+}
+
+}  // namespace
+
+void writeStereoCalibrationSettings(const fs::path& file, const StereoCalibrationResult& r, double fps) {
+  const PinholeCamera<double>& k = r.rectification.camera.pinhole;
+  std::string y = "%YAML:1.0\n# Written by orbis calibrate: ORB-SLAM2's rectified stereo settings. Camera.* is the\n"
+                  "# rectified pinhole both images share; LEFT./RIGHT. rectify raw frames to it on load.\n";
+  y += "Sensor: \"stereo\"\n\n";
+  y += "Camera.fx: " + real(k.fx) + "\nCamera.fy: " + real(k.fy) + "\nCamera.cx: " + real(k.cx) + "\nCamera.cy: " +
+       real(k.cy) + "\n\nCamera.k1: 0.0\nCamera.k2: 0.0\nCamera.p1: 0.0\nCamera.p2: 0.0\n\n";
+  y += "Camera.width: " + std::to_string(k.width) + "\nCamera.height: " + std::to_string(k.height) + "\n\n";
+  y += "# Baseline (" + real(r.rectification.camera.baseline) + " m) times fx.\nCamera.bf: " +
+       real(r.rectification.camera.baseline * k.fx) + "\n# Close/far depth threshold, in baselines.\nThDepth: 40.0\n\n";
+  y += frameRateAndExtractor(fps) + "\n";
+  y += rectificationBlock("LEFT.", r.rectification.left) + rectificationBlock("RIGHT.", r.rectification.right);
+  writeText(file, y);
+}
+
+std::string stereoCalibrationJson(const StereoCalibrationResult& r, const CalibrationPattern& pattern,
+                                  const fs::path& settings) {
+  JsonWriter w;
+  w.beginObject();
+  writeCameraFields(w, r.left, pattern, settings);
+  w.key("right").beginObject();
+  writeCameraFields(w, r.right, pattern, settings);
+  w.endObject();
+  w.field("baseline", r.baseline).field("baseline_std", r.baselineSigma).field("stereo_rms", r.rms);
+  w.field("pairs_used", r.pairsUsed);
+  const Eigen::AngleAxisd turn(r.rightFromLeft.rotationMatrix());
+  w.key("rotation_deg").beginArray();
+  for (int i = 0; i < 3; ++i) w.value(turn.axis()[i] * turn.angle() * 180.0 / M_PI);
+  w.endArray();
+  w.key("translation").beginArray();
+  for (int i = 0; i < 3; ++i) w.value(r.rightFromLeft.translation()[i]);
+  w.endArray();
+  const PinholeCamera<double>& k = r.rectification.camera.pinhole;
+  w.key("rectified").beginObject().field("fx", k.fx).field("fy", k.fy).field("cx", k.cx).field("cy", k.cy)
+      .field("bf", k.fx * r.rectification.camera.baseline).field("width", k.width).field("height", k.height).endObject();
+  w.key("pairs").beginArray();
+  for (const StereoPairOutcome& p : r.pairs) {
+    w.beginObject().field("name", p.name).field("used", p.used);
+    if (p.used) w.field("rms_left", p.rmsLeft).field("rms_right", p.rmsRight);
+    if (!p.rejected.empty()) w.field("rejected", p.rejected);
+    w.endObject();
+  }
+  w.endArray();
+  w.key("stereo_warnings").beginArray();
+  for (const std::string& s : r.warnings) w.value(s);
+  w.endArray();
+  w.endObject();
+  return w.str();
+}
+
+void writeStereoCalibrationReport(const fs::path& folder, const StereoCalibrationResult& r,
+                                  const CalibrationPattern& pattern, const cv::Mat& leftPreview,
+                                  const cv::Mat& rightPreview) {
+  writeCalibrationReport(folder / "left", r.left, pattern, leftPreview);
+  writeCalibrationReport(folder / "right", r.right, pattern, rightPreview);
+  writeText(folder / "report.json", stereoCalibrationJson(r, pattern, "") + "\n");
+  if (leftPreview.empty() || rightPreview.empty()) return;
+  const StereoRectification::Images rectified = r.rectification.rectify(leftPreview, rightPreview);
+  cv::Mat pair;
+  cv::hconcat(rectified.left, rectified.right, pair);
+  if (pair.channels() == 1) cv::cvtColor(pair, pair, cv::COLOR_GRAY2BGR);
+  // Rows every 32 pixels: a point of the scene lies on the same row in both halves.
+  for (int y = 16; y < pair.rows; y += 32)
+    cv::line(pair, cv::Point(0, y), cv::Point(pair.cols - 1, y), cv::Scalar(0, 255, 0), 1, cv::LINE_AA);
+  writeImageFile(folder / "rectified.png", pair);
 }
 
 }  // namespace orbis::calibration

@@ -52,13 +52,15 @@ constexpr SettingsKey kSettingsKeys[] = {
     {"ORBextractor.minThFAST", "whole number", "FAST threshold where the first finds too few corners"},
     {"ORBextractor.rightFeaturesFactor", "whole number", "right image's budget multiple (stereo, orbis)"},
     {"LEFT.K", "matrix", "left camera: 3x3 intrinsics before rectification"},
-    {"LEFT.D", "matrix", "left camera: distortion k1 k2 p1 p2 [k3]"},
+    {"LEFT.D", "matrix", "left camera: distortion k1 k2 p1 p2 [k3] (KannalaBrandt8: k1 k2 k3 k4)"},
+    {"LEFT.type", "text", "left camera: KannalaBrandt8 for a fisheye (D holds k1..k4); default pinhole"},
     {"LEFT.R", "matrix", "left camera: 3x3 rectifying rotation"},
     {"LEFT.P", "matrix", "left camera: 3x4 projection after rectification"},
     {"LEFT.width", "whole number", "left camera: image width"},
     {"LEFT.height", "whole number", "left camera: image height"},
     {"RIGHT.K", "matrix", "right camera: 3x3 intrinsics before rectification"},
-    {"RIGHT.D", "matrix", "right camera: distortion k1 k2 p1 p2 [k3]"},
+    {"RIGHT.D", "matrix", "right camera: distortion k1 k2 p1 p2 [k3] (KannalaBrandt8: k1 k2 k3 k4)"},
+    {"RIGHT.type", "text", "right camera: KannalaBrandt8 for a fisheye (D holds k1..k4); default pinhole"},
     {"RIGHT.R", "matrix", "right camera: 3x3 rectifying rotation"},
     {"RIGHT.P", "matrix", "right camera: 3x4 projection after rectification"},
     {"RIGHT.width", "whole number", "right camera: image width"},
@@ -168,10 +170,21 @@ RectificationBlock readBlock(const YamlReader& yaml, const std::string& prefix) 
   RectificationBlock block;
   block.K = yaml.matrix(prefix + "K", 3, 3);
   const Eigen::MatrixXd d = yaml.matrix(prefix + "D");
-  if (std::min(d.rows(), d.cols()) != 1 || (d.size() != 4 && d.size() != 5)) {
-    throw yaml.error(prefix + "D", "expected 4 or 5 distortion coefficients k1 k2 p1 p2 [k3] in one row");
+  if (yaml.has(prefix + "type")) {
+    const std::string type = yaml.string(prefix + "type");
+    if (type != "KannalaBrandt8" && type != "PinHole")
+      throw yaml.error(prefix + "type", "expected KannalaBrandt8 (a fisheye) or PinHole, not '" + type + "'");
+    if (type == "KannalaBrandt8") {
+      if (std::min(d.rows(), d.cols()) != 1 || d.size() != 4)
+        throw yaml.error(prefix + "D", "a KannalaBrandt8 camera takes 4 coefficients k1 k2 k3 k4 in one row");
+      block.fisheye = std::array<double, 4>{d(0), d(1), d(2), d(3)};
+    }
   }
-  block.D = {d(0), d(1), d(2), d(3), d.size() == 5 ? d(4) : 0.0};
+  if (!block.fisheye) {
+    if (std::min(d.rows(), d.cols()) != 1 || (d.size() != 4 && d.size() != 5))
+      throw yaml.error(prefix + "D", "expected 4 or 5 distortion coefficients k1 k2 p1 p2 [k3] in one row");
+    block.D = {d(0), d(1), d(2), d(3), d.size() == 5 ? d(4) : 0.0};
+  }
   block.R = yaml.matrix(prefix + "R", 3, 3);
   block.P = yaml.matrix(prefix + "P", 3, 4);
   block.width = positiveInteger(yaml, prefix + "width");

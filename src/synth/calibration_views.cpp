@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "orbis/calibration/calibration_output.hpp"
+#include "orbis/calibration/stereo_calibrate.hpp"
 #include "orbis/io/image_file.hpp"
 #include "orbis/synth/rng.hpp"
 #include "orbis/util/error.hpp"
@@ -63,7 +64,8 @@ bool wholeBoardInView(const CalibratedCamera& camera, const calibration::Calibra
   return true;
 }
 
-SE3d randomPose(const CalibratedCamera& camera, const calibration::CalibrationPattern& pattern, SynthRng& rng) {
+SE3d randomPose(const CalibratedCamera& camera, const calibration::CalibrationPattern& pattern, SynthRng& rng,
+                const std::optional<CalibratedCamera>& rightCamera, const SE3d& rightFromLeft) {
   const Eigen::Vector2d size = pattern.boardSize();
   const double halfField = camera.fieldOfViewAngle();
   const double maxOffAxis = camera.model == LensModel::Fisheye ? std::min(80.0 * M_PI / 180.0, 0.9 * halfField)
@@ -84,7 +86,9 @@ SE3d randomPose(const CalibratedCamera& camera, const calibration::CalibrationPa
     const SE3d pose(R, distance * direction - R * centre);
     // Seen from its printed side, not too obliquely.
     if (R.col(2).dot(direction) < std::cos(65.0 * M_PI / 180.0)) continue;
-    if (wholeBoardInView(camera, pattern, pose)) return pose;
+    if (wholeBoardInView(camera, pattern, pose) &&
+        (!rightCamera || wholeBoardInView(*rightCamera, pattern, rightFromLeft * pose)))
+      return pose;
   }
   throw Error("calibration views", "", "no pose keeps the whole board in view: the board is too large for the camera");
 }
@@ -126,6 +130,45 @@ cv::Mat renderView(const CalibratedCamera& camera, const std::vector<cv::Mat>& p
   return out;
 }
 
+// The rendered intensities with Gaussian noise, rounded to 8 bits.
+cv::Mat withNoise(const cv::Mat& grey, double sigma, SynthRng& rng) {
+  cv::Mat image(grey.size(), CV_8UC1);
+  for (int y = 0; y < grey.rows; ++y)
+    for (int x = 0; x < grey.cols; ++x) {
+      const double v = grey.at<float>(y, x) + (sigma > 0 ? sigma * rng.normal() : 0.0);
+      image.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+    }
+  return image;
+}
+
+// view_NNN.png of each view's left (or only) or right image into `folder`.
+void writeViewImages(const fs::path& folder, const std::vector<RenderedCalibrationView>& views, bool right) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) throw fileError(folder.string(), "cannot create folder: " + ec.message());
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "view_%03zu.png", i);
+    writeImageFile(folder / name, right ? views[i].right : views[i].image);
+  }
+}
+
+// poses.txt: camera-from-board of each view, one 3x4 row-major matrix per line.
+void writePoses(const fs::path& file, const std::vector<RenderedCalibrationView>& views) {
+  std::string poses;
+  for (const RenderedCalibrationView& view : views) {
+    const Eigen::Matrix<double, 3, 4> m = view.cameraFromBoard.matrix3x4();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) {
+        char value[40];
+        std::snprintf(value, sizeof value, "%.12g%c", m(r, c), r == 2 && c == 3 ? '\n' : ' ');
+        poses += value;
+      }
+  }
+  FILE* f = std::fopen(file.string().c_str(), "w");
+  if (!f || std::fputs(poses.c_str(), f) < 0 || std::fclose(f) != 0) throw fileError(file.string(), "cannot write");
+}
+
 }  // namespace
 
 std::vector<RenderedCalibrationView> renderCalibrationViews(const CalibrationViewsOptions& o) {
@@ -146,14 +189,16 @@ std::vector<RenderedCalibrationView> renderCalibrationViews(const CalibrationVie
   for (int i = 0; i < count; ++i) {
     SynthRng rng(mixSeed(o.seed, static_cast<std::uint64_t>(i) + 1, 77));
     RenderedCalibrationView view;
-    view.cameraFromBoard = o.poses.empty() ? randomPose(o.camera, pattern, rng) : o.poses[static_cast<std::size_t>(i)];
-    const cv::Mat grey = renderView(o.camera, pyramid, metresPerTexel, view.cameraFromBoard * boardFromTarget, o.supersample);
-    view.image = cv::Mat(grey.size(), CV_8UC1);
-    for (int y = 0; y < grey.rows; ++y)
-      for (int x = 0; x < grey.cols; ++x) {
-        const double v = grey.at<float>(y, x) + (o.noiseSigma > 0 ? o.noiseSigma * rng.normal() : 0.0);
-        view.image.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
-      }
+    view.cameraFromBoard = o.poses.empty() ? randomPose(o.camera, pattern, rng, o.rightCamera, o.rightFromLeft)
+                                           : o.poses[static_cast<std::size_t>(i)];
+    view.image = withNoise(renderView(o.camera, pyramid, metresPerTexel, view.cameraFromBoard * boardFromTarget, o.supersample),
+                           o.noiseSigma, rng);
+    if (o.rightCamera) {
+      SynthRng rightRng(mixSeed(o.seed, static_cast<std::uint64_t>(i) + 1, 78));
+      view.right = withNoise(renderView(*o.rightCamera, pyramid, metresPerTexel,
+                                        o.rightFromLeft * view.cameraFromBoard * boardFromTarget, o.supersample),
+                             o.noiseSigma, rightRng);
+    }
     views.push_back(std::move(view));
   }
   return views;
@@ -161,27 +206,26 @@ std::vector<RenderedCalibrationView> renderCalibrationViews(const CalibrationVie
 
 fs::path writeCalibrationViews(const fs::path& outDir, const std::vector<RenderedCalibrationView>& views,
                                const CalibratedCamera& camera) {
-  const fs::path images = outDir / "images";
-  std::error_code ec;
-  fs::create_directories(images, ec);
-  if (ec) throw fileError(images.string(), "cannot create folder: " + ec.message());
-  std::string poses;
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, "view_%03zu.png", i);
-    writeImageFile(images / name, views[i].image);
-    const Eigen::Matrix<double, 3, 4> m = views[i].cameraFromBoard.matrix3x4();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 4; ++c) {
-        char value[40];
-        std::snprintf(value, sizeof value, "%.12g%c", m(r, c), r == 2 && c == 3 ? '\n' : ' ');
-        poses += value;
-      }
-  }
+  writeViewImages(outDir / "images", views, false);
   calibration::writeCalibrationSettings(outDir / "truth.yaml", camera);
-  FILE* f = std::fopen((outDir / "poses.txt").string().c_str(), "w");
-  if (!f || std::fputs(poses.c_str(), f) < 0 || std::fclose(f) != 0) throw fileError((outDir / "poses.txt").string(), "cannot write");
-  return images;
+  writePoses(outDir / "poses.txt", views);
+  return outDir / "images";
+}
+
+fs::path writeStereoCalibrationViews(const fs::path& outDir, const std::vector<RenderedCalibrationView>& views,
+                                     const CalibrationViewsOptions& options) {
+  if (!options.rightCamera) throw Error(outDir.string(), "", "stereo calibration views need a right camera");
+  writeViewImages(outDir / "left", views, false);
+  writeViewImages(outDir / "right", views, true);
+  calibration::writeCalibrationSettings(outDir / "truth_left.yaml", options.camera);
+  calibration::writeCalibrationSettings(outDir / "truth_right.yaml", *options.rightCamera);
+  calibration::StereoCalibrationResult rig;
+  rig.rightFromLeft = options.rightFromLeft;
+  rig.baseline = options.rightFromLeft.translation().norm();
+  rig.rectification = calibration::rectifyRig(options.camera, *options.rightCamera, options.rightFromLeft);
+  calibration::writeStereoCalibrationSettings(outDir / "truth.yaml", rig);
+  writePoses(outDir / "poses.txt", views);
+  return outDir / "left";
 }
 
 }  // namespace orbis::synth

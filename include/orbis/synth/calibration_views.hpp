@@ -11,11 +11,16 @@
 // Gaussian noise of noiseSigma grey levels is added. Everything is a function of the options and
 // the seed. writeCalibrationViews() writes them as OUTDIR/images/view_NNN.png with truth.yaml (the
 // camera, as `orbis calibrate` writes its result) and poses.txt (camera-from-board, one 3x4 row-major
-// matrix per view).
+// matrix per view). Given a right camera, the views are of a stereo rig: every pose keeps the whole
+// board in view of both cameras, each view gets the right camera's image too (rendered the same
+// way, with its own noise), and writeCalibrationViews writes OUTDIR/left/ and OUTDIR/right/ with
+// truth_left.yaml, truth_right.yaml and truth.yaml (the rig's rectified stereo settings, as
+// `orbis calibrate --right` writes them).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -43,21 +48,30 @@ struct CalibrationViewsOptions {
   int pixelsPerSquare = 64;  // of the printed board, before its pyramid
   // Camera-from-board poses to render instead of random ones (then `views` is ignored).
   std::vector<SE3d> poses;
+  // A stereo rig: the right camera, and where it is (x_right = rightFromLeft x_left).
+  std::optional<calibration::CalibratedCamera> rightCamera;
+  SE3d rightFromLeft;  // the rig's extrinsics, with rightCamera
 };
 
 // One rendered view.
 struct RenderedCalibrationView {
   cv::Mat image;  // CV_8UC1
-  // The board's pose in the camera.
+  cv::Mat right;  // CV_8UC1, stereo rigs only
+  // The board's pose in the (left) camera.
   SE3d cameraFromBoard;
 };
 
 // Renders views of the pattern with exact poses (the calibration tests' ground truth).
 std::vector<RenderedCalibrationView> renderCalibrationViews(const CalibrationViewsOptions& options);
 
-// Returns the images' folder.
+// Returns the images' folder (a stereo rig's: the left camera's).
 std::filesystem::path writeCalibrationViews(const std::filesystem::path& outDir,
                                             const std::vector<RenderedCalibrationView>& views,
                                             const calibration::CalibratedCamera& camera);
+// Writes a stereo rig's views (left/, right/, truth_left.yaml, truth_right.yaml, truth.yaml,
+// poses.txt of the left camera); returns the left images' folder.
+std::filesystem::path writeStereoCalibrationViews(const std::filesystem::path& outDir,
+                                                  const std::vector<RenderedCalibrationView>& views,
+                                                  const CalibrationViewsOptions& options);
 
 }  // namespace orbis::synth
