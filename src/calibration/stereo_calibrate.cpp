@@ -206,7 +206,17 @@ CameraCalibration rectificationInput(const CalibratedCamera& c, const SE3d& came
 }  // namespace
 
 StereoRectification rectifyRig(const CalibratedCamera& left, const CalibratedCamera& right, const SE3d& rightFromLeft) {
-  return rectifyStereo(rectificationInput(left, SE3d()), rectificationInput(right, rightFromLeft));
+  const StereoRectification rectified = rectifyStereo(rectificationInput(left, SE3d()), rectificationInput(right, rightFromLeft));
+  if (left.model != LensModel::Fisheye) return rectified;
+  // fisheye::stereoRectify places the principal point unstably for lenses near 180 degrees (a
+  // calibrated 180-degree rig came out at cx = -53 of 640 where its truth gives 320): the
+  // rectified pair looks straight ahead instead, principal point at the image centre.
+  RectificationBlock l = rectified.left, r = rectified.right;
+  for (RectificationBlock* b : {&l, &r}) {
+    b->P(0, 2) = 0.5 * (left.width - 1);
+    b->P(1, 2) = 0.5 * (left.height - 1);
+  }
+  return rectificationFromBlocks(l, r, "stereo calibration");
 }
 
 StereoCalibrationResult calibrateStereo(const std::vector<CalibrationView>& left, const std::vector<CalibrationView>& right,

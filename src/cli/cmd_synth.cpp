@@ -89,8 +89,16 @@ int renderCalibrationTarget(const ArgParser& p, const synth::SynthOptions& o, co
     c.distortion = distortion.empty() ? std::vector<double>(5, 0.0) : distortion;
   }
   const bool json = p.has("--json");
+  v.squareOn = p.has("--square-on");
+  if (p.has("--rig")) {
+    // The right camera: the same lens, --baseline to the right, the optical axes parallel.
+    if (!(o.baseline > 0)) throw Error("argument --baseline", "", "a stereo rig needs a positive baseline");
+    v.rightCamera = c;
+    v.rightFromLeft = SE3d(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-o.baseline, 0, 0));
+  }
   const std::vector<synth::RenderedCalibrationView> views = synth::renderCalibrationViews(v);
-  const std::filesystem::path images = synth::writeCalibrationViews(p.pos(0), views, c);
+  const std::filesystem::path images = v.rightCamera ? synth::writeStereoCalibrationViews(p.pos(0), views, v)
+                                                     : synth::writeCalibrationViews(p.pos(0), views, c);
   if (json) {
     JsonWriter w;
     w.beginObject().field("images", images.string()).field("truth", (std::filesystem::path(p.pos(0)) / "truth.yaml").string())
@@ -141,6 +149,9 @@ int runSynth(const std::vector<std::string>& args) {
               "render calibration views of this board instead of a sequence (chessboard:COLSxROWS:SQUARE or "
               "charuco:COLSxROWS:SQUARE:MARKER[:DICT], as orbis calibrate): OUTDIR/images, truth.yaml, poses.txt")
       .option("--views", "N", "calibration views to render (with --pattern)", "30")
+      .flag("--square-on", "with --pattern, every board parallel to the image plane (a degenerate set calibration refuses)")
+      .flag("--rig", "with --pattern, a stereo rig's views: a second camera with the same lens --baseline to the "
+                     "right (OUTDIR/left, OUTDIR/right, truth.yaml the rig's rectified stereo settings)")
       .option("--fy", "F", "with --pattern, a pinhole's vertical focal length (default: --fx)")
       .option("--cx", "U", "with --pattern, the principal point's column (default: the image centre)")
       .option("--cy", "V", "with --pattern, the principal point's row (default: the image centre)")

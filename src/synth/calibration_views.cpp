@@ -65,7 +65,7 @@ bool wholeBoardInView(const CalibratedCamera& camera, const calibration::Calibra
 }
 
 SE3d randomPose(const CalibratedCamera& camera, const calibration::CalibrationPattern& pattern, SynthRng& rng,
-                const std::optional<CalibratedCamera>& rightCamera, const SE3d& rightFromLeft) {
+                const CalibrationViewsOptions& o) {
   const Eigen::Vector2d size = pattern.boardSize();
   const double halfField = camera.fieldOfViewAngle();
   const double maxOffAxis = camera.model == LensModel::Fisheye ? std::min(80.0 * M_PI / 180.0, 0.9 * halfField)
@@ -79,15 +79,17 @@ SE3d randomPose(const CalibratedCamera& camera, const calibration::CalibrationPa
     const double distance = camera.fx * size.x() / (fraction * camera.width);
     const double tiltX = rng.uniform(-45.0, 45.0) * M_PI / 180.0, tiltY = rng.uniform(-45.0, 45.0) * M_PI / 180.0;
     const double roll = rng.uniform(-M_PI, M_PI);
-    const Eigen::Matrix3d R = alignZ(direction) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                              Eigen::AngleAxisd(tiltX, Eigen::Vector3d::UnitX()).toRotationMatrix() *
-                              Eigen::AngleAxisd(tiltY, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Matrix3d R = o.squareOn ? Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix()
+                                         : Eigen::Matrix3d(alignZ(direction) *
+                                                           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                                                           Eigen::AngleAxisd(tiltX, Eigen::Vector3d::UnitX()).toRotationMatrix() *
+                                                           Eigen::AngleAxisd(tiltY, Eigen::Vector3d::UnitY()).toRotationMatrix());
     const Eigen::Vector3d centre(0.5 * size.x(), 0.5 * size.y(), 0.0);
     const SE3d pose(R, distance * direction - R * centre);
     // Seen from its printed side, not too obliquely.
     if (R.col(2).dot(direction) < std::cos(65.0 * M_PI / 180.0)) continue;
     if (wholeBoardInView(camera, pattern, pose) &&
-        (!rightCamera || wholeBoardInView(*rightCamera, pattern, rightFromLeft * pose)))
+        (!o.rightCamera || wholeBoardInView(*o.rightCamera, pattern, o.rightFromLeft * pose)))
       return pose;
   }
   throw Error("calibration views", "", "no pose keeps the whole board in view: the board is too large for the camera");
@@ -189,7 +191,7 @@ std::vector<RenderedCalibrationView> renderCalibrationViews(const CalibrationVie
   for (int i = 0; i < count; ++i) {
     SynthRng rng(mixSeed(o.seed, static_cast<std::uint64_t>(i) + 1, 77));
     RenderedCalibrationView view;
-    view.cameraFromBoard = o.poses.empty() ? randomPose(o.camera, pattern, rng, o.rightCamera, o.rightFromLeft)
+    view.cameraFromBoard = o.poses.empty() ? randomPose(o.camera, pattern, rng, o)
                                            : o.poses[static_cast<std::size_t>(i)];
     view.image = withNoise(renderView(o.camera, pyramid, metresPerTexel, view.cameraFromBoard * boardFromTarget, o.supersample),
                            o.noiseSigma, rng);

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "frame_preparation.hpp"
+#include "orbis/camera/rectification.hpp"
 #include "orbis/eval/metrics.hpp"
 #include "orbis/io/dense_cloud.hpp"
 #include "orbis/io/overview.hpp"
@@ -478,7 +479,52 @@ DatasetCamera sourceCamera(const FrameSource& source) {
               "`orbis calibrate` (docs/guide/own-camera.md)");
 }
 
-RunReport runFrames(FrameSource& source, const RunOptions& options, const Defaults& defaults) {
+// Raw stereo frames rectified on load by the settings' LEFT./RIGHT. blocks (as ORB-SLAM2's
+// stereo examples do): for sources without a calibration of their own; a dataset rectifies itself.
+class RectifyingSource final : public FrameSource {
+ public:
+  RectifyingSource(FrameSource& raw, StereoRectification rectification, std::string settings)
+      : raw_(raw), rectification_(std::move(rectification)), settings_(std::move(settings)) {
+    warnings_ = raw_.warnings();
+  }
+  std::optional<SourceFrame> next() override {
+    std::optional<SourceFrame> frame = raw_.next();
+    if (!frame || frame->right.empty()) return frame;
+    const RectificationBlock& block = rectification_.left;
+    if (frame->image.cols != block.width || frame->image.rows != block.height || frame->right.size() != frame->image.size())
+      throw Error(settings_, "key LEFT.width",
+                  "rectifies " + std::to_string(block.width) + "x" + std::to_string(block.height) + " images but " +
+                      raw_.name() + " delivers " + std::to_string(frame->image.cols) + "x" +
+                      std::to_string(frame->image.rows) + " (right " + std::to_string(frame->right.cols) + "x" +
+                      std::to_string(frame->right.rows) + "): calibrate the rig at the size the frames come in");
+    StereoRectification::Images rectified = rectification_.rectify(frame->image, frame->right);
+    frame->image = std::move(rectified.left);
+    frame->right = std::move(rectified.right);
+    return frame;
+  }
+  std::string name() const override { return raw_.name(); }
+  SensorKind sensor() const override { return raw_.sensor(); }
+  bool live() const override { return raw_.live(); }
+  std::optional<std::size_t> expectedFrames() const override { return raw_.expectedFrames(); }
+  const Trajectory& groundTruth() const override { return raw_.groundTruth(); }
+  std::size_t dropped() const override { return raw_.dropped(); }
+  std::string endReason() const override { return raw_.endReason(); }
+  void setCancelCheck(std::function<bool()> cancel) override { raw_.setCancelCheck(std::move(cancel)); }
+
+ private:
+  FrameSource& raw_;
+  StereoRectification rectification_;
+  std::string settings_;
+};
+
+RunReport runFrames(FrameSource& rawSource, const RunOptions& options, const Defaults& defaults) {
+  std::unique_ptr<FrameSource> rectifying;
+  if (options.settings && rawSource.sensor() == SensorKind::Stereo && !rawSource.hasCalibration()) {
+    const Settings s = Settings::load(*options.settings, SensorKind::Stereo);
+    if (s.rectification)
+      rectifying = std::make_unique<RectifyingSource>(rawSource, s.stereoRectification(), options.settings->string());
+  }
+  FrameSource& source = rectifying ? *rectifying : rawSource;
   RunReport report;
   report.dataset = source.name();
   report.live = source.live();

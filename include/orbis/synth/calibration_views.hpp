@@ -48,6 +48,9 @@ struct CalibrationViewsOptions {
   int pixelsPerSquare = 64;  // of the printed board, before its pyramid
   // Camera-from-board poses to render instead of random ones (then `views` is ignored).
   std::vector<SE3d> poses;
+  // Every board parallel to the image plane (a degenerate set, for testing that calibration
+  // refuses it): random poses keep only the turn about the optical axis.
+  bool squareOn = false;
   // A stereo rig: the right camera, and where it is (x_right = rightFromLeft x_left).
   std::optional<calibration::CalibratedCamera> rightCamera;
   SE3d rightFromLeft;  // the rig's extrinsics, with rightCamera
