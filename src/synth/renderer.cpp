@@ -215,35 +215,48 @@ void Renderer::renderRows(const PinholeCamera<double>& camera, const SE3d& camer
   };
 
   const double step = 1.0 / ss;
-  for (int y = rowBegin; y < rowEnd; ++y) {
-    float* g = gray.ptr<float>(y);
-    float* dp = depth ? depth->ptr<float>(y) : nullptr;
-    const int* tileRow = tileBegin_.data() + (y / kTile) * tilesX_;
-    for (int x = 0; x < camera.width; ++x) {
-      const int tile = x / kTile;
-      const int* list = tileRects_.data() + tileRow[tile];
-      const int count = tileRow[tile + 1] - tileRow[tile];
-      float sum = 0.0f;
-      double centreDepth = std::numeric_limits<double>::infinity();
-      for (int sy = 0; sy < ss; ++sy) {
-        const double v = y - 0.5 + (sy + 0.5) * step;
-        const double yn = (v - camera.cy) / camera.fy;
-        for (int sx = 0; sx < ss; ++sx) {
-          const double u = x - 0.5 + (sx + 0.5) * step;
-          float value = 0.0f;
-          const double t = trace(list, count, (u - camera.cx) / camera.fx, yn, true, value);
-          sum += value;
-          if (centreIsSample && sx == ss / 2 && sy == ss / 2) centreDepth = t;
+  // The centre sample's depth, kept by shade for depthOf when the centre is one of the samples.
+  double centreDepth = std::numeric_limits<double>::infinity();
+  forEachPixel(
+      rowBegin, rowEnd, camera.width, gray, depth,
+      [&](int x, int y, const int* list, int count) {
+        float sum = 0.0f;
+        centreDepth = std::numeric_limits<double>::infinity();
+        for (int sy = 0; sy < ss; ++sy) {
+          const double v = y - 0.5 + (sy + 0.5) * step;
+          const double yn = (v - camera.cy) / camera.fy;
+          for (int sx = 0; sx < ss; ++sx) {
+            const double u = x - 0.5 + (sx + 0.5) * step;
+            float value = 0.0f;
+            const double t = trace(list, count, (u - camera.cx) / camera.fx, yn, true, value);
+            sum += value;
+            if (centreIsSample && sx == ss / 2 && sy == ss / 2) centreDepth = t;
+          }
         }
-      }
-      g[x] = sum * invSamples;
-      if (dp) {
+        return sum * invSamples;
+      },
+      [&](int x, int y, const int* list, int count) {
         if (!centreIsSample) {
           float unused = 0.0f;
           centreDepth = trace(list, count, (x - camera.cx) / camera.fx, (y - camera.cy) / camera.fy, false, unused);
         }
-        dp[x] = std::isfinite(centreDepth) ? static_cast<float>(centreDepth) : 0.0f;
-      }
+        return std::isfinite(centreDepth) ? static_cast<float>(centreDepth) : 0.0f;
+      });
+}
+
+template <class Shade, class DepthOf>
+void Renderer::forEachPixel(int rowBegin, int rowEnd, int width, cv::Mat& gray, cv::Mat* depth, const Shade& shade,
+                            const DepthOf& depthOf) const {
+  for (int y = rowBegin; y < rowEnd; ++y) {
+    float* g = gray.ptr<float>(y);
+    float* dp = depth ? depth->ptr<float>(y) : nullptr;
+    const int* tileRow = tileBegin_.data() + (y / kTile) * tilesX_;
+    for (int x = 0; x < width; ++x) {
+      const int tile = x / kTile;
+      const int* list = tileRects_.data() + tileRow[tile];
+      const int count = tileRow[tile + 1] - tileRow[tile];
+      g[x] = shade(x, y, list, count);
+      if (dp) dp[x] = depthOf(x, y, list, count);
     }
   }
 }
@@ -289,32 +302,26 @@ void Renderer::renderRowsFisheye(const KannalaBrandtCamera<double>& camera, cons
   const int ss = std::max(1, options_.supersample);
   const std::size_t perPixel = static_cast<std::size_t>(ss * ss);
   const float invSamples = 1.0f / static_cast<float>(ss * ss);
-  for (int y = rowBegin; y < rowEnd; ++y) {
-    float* g = gray.ptr<float>(y);
-    float* dp = depth ? depth->ptr<float>(y) : nullptr;
-    const int* tileRow = tileBegin_.data() + (y / kTile) * tilesX_;
-    for (int x = 0; x < camera.width; ++x) {
-      const int tile = x / kTile;
-      const int* list = tileRects_.data() + tileRow[tile];
-      const int count = tileRow[tile + 1] - tileRow[tile];
-      const Eigen::Vector3d* rays = fisheyeRays_.data() + (static_cast<std::size_t>(y) * camera.width + x) * perPixel;
-      float sum = 0.0f;
-      for (std::size_t k = 0; k < perPixel; ++k) {
-        if (rays[k].z() > 1.5) continue;  // outside the lens's field of view: black
-        float value = 0.0f;
-        traceRay(frameRects_.data(), list, count, o, R * rays[k], 1.0, true, options_.lodBias, value);
-        sum += value;
-      }
-      g[x] = sum * invSamples;
-      if (dp) {
+  forEachPixel(
+      rowBegin, rowEnd, camera.width, gray, depth,
+      [&](int x, int y, const int* list, int count) {
+        const Eigen::Vector3d* rays = fisheyeRays_.data() + (static_cast<std::size_t>(y) * camera.width + x) * perPixel;
+        float sum = 0.0f;
+        for (std::size_t k = 0; k < perPixel; ++k) {
+          if (rays[k].z() > 1.5) continue;  // outside the lens's field of view: black
+          float value = 0.0f;
+          traceRay(frameRects_.data(), list, count, o, R * rays[k], 1.0, true, options_.lodBias, value);
+          sum += value;
+        }
+        return sum * invSamples;
+      },
+      [&](int x, int y, const int* list, int count) {
         // Depth along the optical axis of the ray through the pixel centre.
         const Eigen::Vector3d centre = camera.bearing(Eigen::Vector2d(x, y));
         float unused = 0.0f;
         const double range = traceRay(frameRects_.data(), list, count, o, R * centre, 1.0, false, 0.0, unused);
-        dp[x] = std::isfinite(range) ? static_cast<float>(range * centre.z()) : 0.0f;
-      }
-    }
-  }
+        return std::isfinite(range) ? static_cast<float>(range * centre.z()) : 0.0f;
+      });
 }
 
 }  // namespace orbis::synth

@@ -72,6 +72,11 @@ class Renderer {
                          int rowEnd, cv::Mat& gray, cv::Mat* depth) const;
   template <class RenderRows>
   void renderInThreads(int height, const RenderRows& rows);
+  // Walks rows [rowBegin, rowEnd) of a width-pixel image: shade(x, y, tileList, tileCount) gives
+  // the pixel's grey value, and depthOf(x, y, tileList, tileCount) its depth when `depth` is asked.
+  template <class Shade, class DepthOf>
+  void forEachPixel(int rowBegin, int rowEnd, int width, cv::Mat& gray, cv::Mat* depth, const Shade& shade,
+                    const DepthOf& depthOf) const;
   template <class BoundsOf>
   void binWith(const Scene& scene, int width, int height, double focal, const SE3d& cameraToWorld,
                const BoundsOf& boundsOf);
