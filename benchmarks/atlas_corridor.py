@@ -9,11 +9,12 @@ Sim(3) for monocular), maps opened, the frame the new map started on and the fra
 the seam error: the relative pose between the frames of the two keyframes the merge matched (one
 per map) against the ground truth (translation error, mm; monocular in ground-truth units at the
 run's scale), and the gap error: the same across the blackout (the last frame of the first map and
-the first of the next), which only the rest of the loop ties together. Pure Python (no NumPy); the JSON of every row goes
+the first of the next), which only the rest of the loop ties together; "+after": frames from the
+end of the blackout to the merge. Pure Python (no NumPy); the JSON of every row goes
 to WORK/atlas_corridor.json.
 
   benchmarks/atlas_corridor.py [--orbis BIN] [--work DIR] [--seeds 1,2] [--blackouts 100:30,200:30]
-                               [--sensors rgbd,stereo,mono] [--reuse]
+                               [--sensors rgbd,stereo,mono] [--reuse] [--markdown]
 """
 import argparse
 import json
@@ -110,13 +111,14 @@ def score(out, gt, start, count, sensor):
         "ate_mm": 1000 * report["ate"]["rmse"] if report.get("ate") else None,
         "maps": len(report.get("maps", [])) or 1,
         "new_map_frame": None, "merge_frame": None, "merge_inliers": None, "merge_ms": None, "seam_error_mm": None,
-        "gap_error_mm": None,
+        "gap_error_mm": None, "frames_to_merge": None,
     }
     if len(report.get("maps", [])) > 1:
         row["new_map_frame"] = report["maps"][1]["start_frame"]
     if report.get("merges"):
         m = report["merges"][0]
-        row.update(merge_frame=m["frame"], merge_inliers=m["inliers"], merge_ms=round(m["ms"], 1))
+        row.update(merge_frame=m["frame"], merge_inliers=m["inliers"], merge_ms=round(m["ms"], 1),
+                   frames_to_merge=m["frame"] - end)
     # The seam: the frames of the two keyframes the merge matched (one per map), and across the
     # blackout: the last frame of the first map and the first of the next (nothing ties them but
     # the rest of the loop).
@@ -150,11 +152,12 @@ def main():
     ap.add_argument("--blackouts", default="100:30,200:30")
     ap.add_argument("--sensors", default="rgbd,stereo,mono")
     ap.add_argument("--reuse", action="store_true", help="score existing runs in WORK instead of running again")
+    ap.add_argument("--markdown", action="store_true", help="also print the rows as a Markdown table")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     rows = []
     print(f"{'sensor':7} {'seed':>4} {'blackout':>9} {'mode':7} {'after':>9} {'ATE mm':>8} {'maps':>4} "
-          f"{'new map':>7} {'merge':>5} {'inl':>4} {'seam mm':>8} {'gap mm':>8}")
+          f"{'new map':>7} {'merge':>5} {'+after':>6} {'inl':>4} {'seam mm':>8} {'gap mm':>8}")
     for seed in args.seeds.split(","):
         for black in args.blackouts.split(","):
             start, count = (int(x) for x in black.split(":"))
@@ -180,9 +183,27 @@ def main():
                         print(f"{sensor:7} {seed:>4} {black:>9} {mode:7} "
                               f"{row['tracked_after_blackout']:>4}/{row['frames_after_blackout']:<4} "
                               f"{fmt(row['ate_mm'], '8.1f')} {row['maps']:>4} {fmt(row['new_map_frame'], '>7')} "
-                              f"{fmt(row['merge_frame'], '>5')} {fmt(row['merge_inliers'], '>4')} "
+                              f"{fmt(row['merge_frame'], '>5')} {fmt(row['frames_to_merge'], '>6')} "
+                              f"{fmt(row['merge_inliers'], '>4')} "
                               f"{fmt(row['seam_error_mm'], '8.1f')} {fmt(row['gap_error_mm'], '8.1f')}", flush=True)
     json.dump(rows, open(os.path.join(args.work, "atlas_corridor.json"), "w"), indent=1)
+    if args.markdown:
+        print_markdown(rows)
+
+
+def print_markdown(rows):
+    cell = lambda v, f="": "–" if v is None else format(v, f)
+    print("\n| sensor | seed | blackout | mode | after | ATE mm | maps | new map at | merge at | +after "
+          "| inliers | seam mm | gap mm |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        if "error" in r:
+            print(f"| {r['sensor']} | {r['seed']} | {r['blackout']} | {r['mode']} | error: {r['error']} |||||||||")
+            continue
+        print(f"| {r['sensor']} | {r['seed']} | {r['blackout']} | {r['mode']} | "
+              f"{r['tracked_after_blackout']}/{r['frames_after_blackout']} | {cell(r['ate_mm'], '.1f')} | {r['maps']} | "
+              f"{cell(r['new_map_frame'])} | {cell(r['merge_frame'])} | {cell(r['frames_to_merge'])} | "
+              f"{cell(r['merge_inliers'])} | {cell(r['seam_error_mm'], '.1f')} | {cell(r['gap_error_mm'], '.1f')} |")
 
 
 if __name__ == "__main__":

@@ -87,15 +87,25 @@ std::size_t Map::mapPointCount(std::uint32_t mapId) const {
   return n;
 }
 
-void Map::mergeInto(std::uint32_t from, std::uint32_t into) {
+void Map::mergeInto(std::uint32_t from, std::uint32_t into, double scale) {
   for (const auto& kf : keyFrames_)
     if (kf->mapId() == from) {
       kf->setMapId(into);
       kf->setGauge(false);
     }
   records_.at(from).mergedInto = into;
-  ++mergeCount_;
+  merges_.push_back({from, into, scale});
   if (active_ == from) active_ = into;
+}
+
+bool Map::mapLeadsTo(std::uint32_t trackedIn, std::uint32_t mapId) const {
+  // Each map is merged at most once, so the chain of merges ends; the bound guards a bad record.
+  for (std::size_t step = 0; step <= records_.size(); ++step) {
+    if (trackedIn == mapId) return true;
+    if (trackedIn >= records_.size() || !records_[trackedIn].mergedInto) return false;
+    trackedIn = *records_[trackedIn].mergedInto;
+  }
+  return false;
 }
 
 void Map::restoreAtlas(std::vector<AtlasMapRecord> records, std::uint32_t active) {

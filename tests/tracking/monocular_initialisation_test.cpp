@@ -2,7 +2,8 @@
 // one descriptor each, a few bits flipped per view, 0.3 px noise): a sideways-moving camera
 // waits while the parallax is low, then initialises with two keyframes, points at median
 // depth 1 and the true motion direction; a rotating and a static camera never initialise and
-// say why; the same frames give the same map bits.
+// say why; the same frames give the same map bits. A monocular merge (issue 32) that moves the
+// tracker's map by a similarity rescales the motion model and the kept trajectory with it.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -14,6 +15,7 @@
 #include <random>
 #include <vector>
 
+#include "orbis/geometry/sim3.hpp"
 #include "orbis/system/dataset_runner.hpp"
 #include "orbis/tracking/tracker.hpp"
 
@@ -187,6 +189,75 @@ TEST(MonocularInitialisation, SameFramesGiveTheSameMap) {
   const auto pA = a.mapPoints(), pB = b.mapPoints();
   ASSERT_EQ(pA.size(), pB.size());
   for (std::size_t i = 0; i < pA.size(); ++i) EXPECT_EQ(pA[i]->position(), pB[i]->position());
+}
+
+// The named counter of a logged frame event (-1 when absent).
+double frameCounter(const StageEvent& event, const std::string& name) {
+  for (const auto& [key, value] : event.values)
+    if (key == name) return value;
+  return -1;
+}
+
+TEST(MonocularMerge, SimilarityMoveRescalesMotionModelAndTrajectory) {
+  // The loop thread's merge moves the tracker's map into another's frame by a similarity; here
+  // scale 0.02 (exaggerated so that an unscaled motion model misses every match in its search
+  // window) and the other map is an empty one.
+  const std::vector<SE3d> poses = sidewaysPoses(26);
+  const std::vector<Landmark> landmarks = makeLandmarks(3);
+  std::mt19937 rng(3);
+  Map map;
+  StageTimer timer;
+  timer.enableEvents(true);
+  Tracker<Monocular> tracker(map, vocabulary(), nullptr, TrackerOptions{}, &timer);
+  const std::size_t mergeAt = 25;
+  for (std::size_t k = 0; k < mergeAt; ++k) tracker.track(makeFrame(k, observe(landmarks, poses[k], rng)));
+  ASSERT_EQ(tracker.state(), TrackingState::Ok);
+  ASSERT_TRUE(tracker.motionModel());
+  const double stepBefore = tracker.motionModel()->translation().norm();
+  std::vector<SE3d> posesBefore;
+  for (const TrackedFrame& f : tracker.trackedFrames()) posesBefore.push_back(Tracker<Monocular>::worldPose(f));
+  ASSERT_GE(posesBefore.size(), 10u);
+
+  const Sim3d S(0.02, Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix(),
+                Eigen::Vector3d(1, -2, 0.5));
+  const auto moved = [&](const SE3d& Tcw) {
+    const Sim3d Scw = Sim3d(Tcw) * S.inverse();
+    return SE3d(Scw.so3(), Scw.translation() / Scw.scale());
+  };
+  {
+    std::lock_guard lock(map.mutex());
+    const std::uint32_t kept = map.startNewMap(mergeAt);
+    for (MapPoint* p : map.mapPoints(0)) p->setPosition(S * p->position());
+    for (KeyFrame* kf : map.keyFrames(0)) kf->setPose(moved(kf->Tcw()));
+    for (MapPoint* p : map.mapPoints(0)) p->updateNormalAndDepth();
+    map.mergeInto(0, kept, S.scale());
+  }
+  const TrackResult r = tracker.track(makeFrame(mergeAt, observe(landmarks, poses[mergeAt], rng)));
+  ASSERT_EQ(r.state, TrackingState::Ok);
+
+  // Every frame tracked before the merge moved with its map.
+  ASSERT_GE(tracker.trackedFrames().size(), posesBefore.size() + 1);
+  double worstCentre = 0, worstRotation = 0;
+  for (std::size_t i = 0; i < posesBefore.size(); ++i) {
+    const SE3d expected = moved(posesBefore[i]);
+    const SE3d now = Tracker<Monocular>::worldPose(tracker.trackedFrames()[i]);
+    worstCentre = std::max(worstCentre, (now.inverse().translation() - expected.inverse().translation()).norm());
+    worstRotation = std::max(worstRotation, (now.rotationMatrix() - expected.rotationMatrix()).norm());
+  }
+  std::printf("  after the merge: kept frames off by %.2e (centre), %.2e (rotation)\n", worstCentre, worstRotation);
+  EXPECT_LT(worstCentre, 1e-9);
+  EXPECT_LT(worstRotation, 1e-9);
+  // The motion model predicted the frame after the merge (its matches found by projection).
+  const std::vector<StageEvent> events = timer.events();
+  ASSERT_GE(events.size(), 2u);
+  const double matchesBefore = frameCounter(events[events.size() - 2], "motion_matches");
+  const double matchesAfter = frameCounter(events.back(), "motion_matches");
+  std::printf("  motion-model matches: %.0f before the merge, %.0f after\n", matchesBefore, matchesAfter);
+  ASSERT_GT(matchesBefore, 50);
+  EXPECT_GT(matchesAfter, 0.8 * matchesBefore);
+  // And it goes on in the merged map's unit.
+  ASSERT_TRUE(tracker.motionModel());
+  EXPECT_NEAR(tracker.motionModel()->translation().norm() / stepBefore, S.scale(), 0.3 * S.scale());
 }
 
 }  // namespace

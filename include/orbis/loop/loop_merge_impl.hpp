@@ -58,8 +58,9 @@ void LoopCloser<Sensor>::mergeMaps(KeyFrame* kf, LoopCandidate& place) {
     const Correction S = moveActive ? otherFromActive : otherFromActive.inverse();
     event.movedKeyFrames = moveActive ? activeKeyFrames : otherKeyFrames;
     event.movedPoints = map_.mapPointCount(event.movedMap);
+    if constexpr (!Sensor::kMetricScale) event.scale = S.scale();
     moveMap(event.movedMap, S);
-    map_.mergeInto(event.movedMap, event.keptMap);
+    map_.mergeInto(event.movedMap, event.keptMap, event.scale);
     map_.setActiveMap(event.keptMap);
     // kf's pose in the merged frame: where the place put it when kf's map moved (its pose now),
     // else unchanged (the other map came to it).
@@ -70,7 +71,6 @@ void LoopCloser<Sensor>::mergeMaps(KeyFrame* kf, LoopCandidate& place) {
     const Eigen::Quaterniond q(S.so3().matrix());
     event.rotation = Eigen::Vector4d(q.w(), q.x(), q.y(), q.z());
     event.translation = S.translation();
-    if constexpr (!Sensor::kMetricScale) event.scale = S.scale();
   }
   // The seam, as a loop: fusion, links, essential graph with the other side fixed.
   Fusion fusion;

@@ -34,6 +34,17 @@ struct AtlasMapRecord {
   std::optional<std::uint32_t> mergedInto;  // set once it has been merged into another map
 };
 
+// One merge, in the order they happened: map `from` was moved into `into`'s frame by a transform
+// x_into = scale·R·x_from + t (scale 1 for metric sensors) and relabelled as it.
+struct AtlasMerge {
+  // @{
+  // The moved map, the kept map and the move's scale.
+  std::uint32_t from = 0;
+  std::uint32_t into = 0;
+  double scale = 1;
+  // @}
+};
+
 // The map: owns every keyframe and map point (bad ones too, so pointers stay valid), guarded by one
 // mutex.
 class Map {
@@ -90,10 +101,16 @@ class Map {
   std::size_t mapPointCount(std::uint32_t mapId) const;
   // @}
   // Relabels every keyframe (bad ones too) of map `from` as map `into`'s; `from`'s root stops
-  // being a BA gauge. Poses are the caller's business (they must already be in into's frame).
-  void mergeInto(std::uint32_t from, std::uint32_t into);
+  // being a BA gauge. Poses are the caller's business (they must already be in into's frame,
+  // moved by a transform of this scale: a tracker rescales what it keeps relative to them).
+  void mergeInto(std::uint32_t from, std::uint32_t into, double scale = 1);
   // How many merges have happened: a tracker that sees it change re-reads its last pose.
-  std::uint64_t mergeCount() const { return mergeCount_; }
+  std::uint64_t mergeCount() const { return merges_.size(); }
+  // Every merge of this session, in order (not saved in map files).
+  const std::vector<AtlasMerge>& merges() const { return merges_; }
+  // Whether frames tracked in map `trackedIn` now belong to map `mapId` (the same map, or one
+  // that map was merged into, directly or through others).
+  bool mapLeadsTo(std::uint32_t trackedIn, std::uint32_t mapId) const;
   // Map files: restores the records (ids 0..count-1) and the active map after loading.
   void restoreAtlas(std::vector<AtlasMapRecord> records, std::uint32_t active);
 
@@ -104,7 +121,7 @@ class Map {
   std::vector<AtlasMapRecord> records_{AtlasMapRecord{}};  // index == map id
   std::vector<char> hasKeyFrame_{0};                       // per map: its root exists
   std::uint32_t active_ = 0;
-  std::uint64_t mergeCount_ = 0;
+  std::vector<AtlasMerge> merges_;
 };
 
 }  // namespace orbis

@@ -141,6 +141,8 @@ class Tracker {
   const std::vector<KeypointState>& keypointStates() const { return keypointStates_; }
   // The last frame's local map.
   const std::vector<MapPoint*>& localMapPoints() const { return localPoints_; }
+  // The motion model: current-from-last of the last two tracked frames (none after a loss).
+  const std::optional<SE3d>& motionModel() const { return velocity_; }
 
  private:
   void computeBow(FrameT& f) const;
@@ -159,6 +161,9 @@ class Tracker {
   bool newMapDue();
   // Opens a new map after a loss and starts it from `f` where the sensor can (metric: at once).
   bool startNewMapAfterLoss(FrameT& f);
+  // Scales what is kept relative to keyframes (frame poses, the motion model) by the scale of
+  // the merges since the last frame that moved their map (monocular; metric merges have none).
+  void followMergeScales();
   bool trackReferenceKeyFrame();
   // Projects the last frame's matches through `motion` (current from last) and optimises.
   bool trackWithMotionModel(const SE3d& motion);

@@ -71,6 +71,10 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
   current_.resetMatches();
   if (recordKeypointStates_) keypointStates_.clear();
   TrackResult result;
+  // Merges happen on the loop thread between frames (this holds the map's mutex throughout).
+  const bool merged = map_.mergeCount() != mergesSeen_;
+  if (merged) followMergeScales();
+  mergesSeen_ = map_.mergeCount();
   diagnostics_.clear();
   note("frame", static_cast<double>(current_.index));
 
@@ -95,7 +99,7 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
       if (state_ == TrackingState::Ok) {
         replaceRetiredPoints(last_);
         // A merge moved the map since the last frame: its pose, re-read through its reference.
-        if (map_.mergeCount() != mergesSeen_ && !tracked_.empty()) last_.Tcw = worldPose(tracked_.back());
+        if (merged && !tracked_.empty()) last_.Tcw = worldPose(tracked_.back());
         // After a loop closure the velocity is still valid but the last pose moved: ORB-SLAM
         // re-reads it from its reference keyframe (updateLastFrame).
         if (withinFramesOfRelocalisation(2)) {
@@ -181,9 +185,24 @@ TrackResult Tracker<Sensor>::track(FrameT frame) {
     timer_->event("frame", std::move(diagnostics_));
     diagnostics_.clear();
   }
-  mergesSeen_ = map_.mergeCount();
   if (state_ != TrackingState::NotInitialised) last_ = std::move(current_);  // current_ is refilled next frame
   return result;
+}
+
+template <SensorConfiguration Sensor>
+void Tracker<Sensor>::followMergeScales() {
+  // A monocular merge moves a map by a similarity: its keyframes' poses follow, but what is kept
+  // relative to them (each frame's pose from its reference keyframe, the motion model) is in the
+  // old map's unit until its translation is scaled as well (rotations are unchanged).
+  const std::vector<AtlasMerge>& merges = map_.merges();
+  for (std::size_t k = mergesSeen_; k < merges.size(); ++k) {
+    const AtlasMerge& merge = merges[k];
+    if (merge.scale == 1.0) continue;
+    for (TrackedFrame& f : tracked_)
+      if (map_.mapLeadsTo(f.mapId, merge.from)) f.Tcr.translation() *= merge.scale;
+    if (velocity_ && !tracked_.empty() && map_.mapLeadsTo(tracked_.back().mapId, merge.from))
+      velocity_->translation() *= merge.scale;
+  }
 }
 
 template <SensorConfiguration Sensor>
