@@ -11,6 +11,8 @@
 // block (quaternion, translation) on a manifold whose update is exp(δ)·T, like ours; the cost
 // function returns [J_δ 0] for the block and PlusJacobian is [I; 0], so Ceres sees J_δ exactly.
 // After the runs a table prints both times, both final costs and the ratio orbis/Ceres.
+// Motion-only problems also run on PoseOnlyProblem (what tracking uses; the same bits as the
+// general problem), printed after the table against both.
 // ORBIS_BAL_FILE=problem-*.txt adds a real BAL problem.
 // ORBIS_BA_THREADS=N (default 1) gives both solvers N threads (orbis: SolverOptions::threads,
 // Ceres: num_threads); with N > 1 the table compares wall time instead, since CPU time then sums
@@ -165,6 +167,19 @@ Outcome solveOrbis(const bench::SlamScene& scene, bool motionOnly, benchmark::St
   optim::SlamProblem<RectifiedStereoCamera<double>> problem;
   for (std::size_t k = 0; k < scene.initialPoses.size(); ++k) problem.addPose(scene.initialPoses[k], scene.poseFixed[k]);
   for (const auto& p : scene.initialPoints) problem.addPoint(p, motionOnly);
+  for (const auto& o : scene.observations) {
+    optim::slam_detail::addObservation(problem, scene.camera, o, optim::kChi2Mono, optim::kChi2Stereo);
+  }
+  state.ResumeTiming();
+  const optim::SolverSummary s = problem.solve(orbisOptions());
+  return {s.initialCost, s.finalCost, s.iterations};
+}
+
+// Motion-only problems as tracking solves them since issue 35: PoseOnlyProblem, the same bits as
+// the general problem above with every point fixed.
+Outcome solveOrbisPoseOnly(const bench::SlamScene& scene, benchmark::State& state) {
+  state.PauseTiming();
+  optim::MotionOnlyProblem<RectifiedStereoCamera<double>> problem(scene.initialPoses[0], scene.initialPoints);
   for (const auto& o : scene.observations) {
     optim::slam_detail::addObservation(problem, scene.camera, o, optim::kChi2Mono, optim::kChi2Stereo);
   }
@@ -353,6 +368,13 @@ void registerAll() {
       for (auto _ : state) o = solveCeres(p->scene, p->motionOnly, state);
       report(state, o);
     })->Unit(benchmark::kMillisecond)->UseRealTime();
+    if (p->motionOnly) {
+      benchmark::RegisterBenchmark(("pose-only/" + p->name).c_str(), [p](benchmark::State& state) {
+        Outcome o;
+        for (auto _ : state) o = solveOrbisPoseOnly(p->scene, state);
+        report(state, o);
+      })->Unit(benchmark::kMillisecond)->UseRealTime();
+    }
   }
   for (const auto& [name, bal] : balCases()) {
     const BalProblem* p = bal.get();
@@ -380,7 +402,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const std::string name = run.benchmark_name();
       const auto slash = name.find('/');
       auto& row = rows_[name.substr(slash + 1)];
-      Side& side = name.substr(0, slash) == "orbis" ? row.orbis : row.ceres;
+      const std::string solver = name.substr(0, slash);
+      Side& side = solver == "orbis" ? row.orbis : solver == "pose-only" ? row.poseOnly : row.ceres;
       side.ms = solverThreads() > 1 ? run.GetAdjustedRealTime() : run.GetAdjustedCPUTime();
       side.finalCost = run.counters.at("final_cost");
       side.iterations = run.counters.at("iterations");
@@ -398,11 +421,19 @@ class RatioReporter : public benchmark::ConsoleReporter {
                   row.ceres.ms, row.orbis.ms / row.ceres.ms, row.orbis.finalCost, row.ceres.finalCost, rel,
                   row.orbis.iterations, row.ceres.iterations);
     }
+    // Motion-only problems: the general problem against PoseOnlyProblem (what tracking runs).
+    for (const auto& [name, row] : rows_) {
+      if (row.poseOnly.ms <= 0) continue;
+      std::printf("%-32s pose-only %.4f ms (general problem %.4f ms, ratio %.3f; ceres %.4f ms, ratio %.3f); "
+                  "final cost %s the general problem's\n",
+                  name.c_str(), row.poseOnly.ms, row.orbis.ms, row.poseOnly.ms / row.orbis.ms, row.ceres.ms,
+                  row.poseOnly.ms / row.ceres.ms, row.poseOnly.finalCost == row.orbis.finalCost ? "equal to" : "DIFFERS from");
+    }
   }
 
  private:
   struct Side { double ms = 0, finalCost = 0, iterations = 0; };
-  struct Row { Side orbis, ceres; };
+  struct Row { Side orbis, ceres, poseOnly; };
   std::map<std::string, Row> rows_;
 };
 

@@ -66,6 +66,65 @@ TEST(OptimSlamBa, MotionOnlyMonocular) {
   EXPECT_LT(positionError(pose, scene.truePoses[0]), 0.01);
 }
 
+// Motion-only BA as it ran on the general sparse problem before PoseOnlyProblem: the reference
+// the specialised path must match bit for bit.
+template <class Camera>
+SE3d motionOnlyOnTheGeneralProblem(const Camera& camera, SE3d pose, std::span<const Eigen::Vector3d> points,
+                                   std::span<const SlamObservation> observations, std::vector<char>& outlier) {
+  const MotionOnlyOptions options;
+  SlamProblem<Camera> robust;
+  robust.addPose(pose);
+  for (const auto& p : points) robust.addPoint(p, /*fixed=*/true);
+  std::vector<ResidualId> ids;
+  for (const auto& o : observations) ids.push_back(slam_detail::addObservation(robust, camera, o, kChi2Mono, kChi2Stereo));
+  outlier.assign(observations.size(), 0);
+  SolverOptions solver;
+  solver.maxIterations = options.iterationsPerRound;
+  solver.linearSolver = LinearSolverKind::DenseCholesky;
+  const SE3d prior = pose;
+  auto round = [&](auto& problem) {
+    problem.setPose(0, prior);
+    problem.solve(solver);
+    int inliers = 0;
+    for (std::size_t k = 0; k < observations.size(); ++k) {
+      const double threshold = observations[k].isStereo() && ids[k].term == 1 ? kChi2Stereo : kChi2Mono;
+      outlier[k] = problem.chi2(ids[k]) > threshold;
+      problem.setActive(ids[k], !outlier[k]);
+      inliers += !outlier[k];
+    }
+    pose = problem.pose(0);
+    return inliers >= 10;
+  };
+  bool goOn = true;
+  for (int r = 0; r < options.robustRounds && goOn; ++r) goOn = round(robust);
+  auto plain = withoutKernel(robust);
+  for (int r = options.robustRounds; r < options.rounds && goOn; ++r) goOn = round(plain);
+  return pose;
+}
+
+// PoseOnlyProblem forms every sum as the general problem does: the same pose to the last bit,
+// with stereo and monocular observations and with monocular ones only.
+TEST(OptimSlamBa, MotionOnlyGivesTheSameBitsAsTheGeneralProblem) {
+  for (const std::uint32_t seed : {42u, 43u, 44u}) {
+    const auto scene = bench::makeMotionOnlyScene(500, seed == 43u ? 0.0 : 0.5, 0.1, seed);
+    std::vector<char> referenceOutliers;
+    const SE3d reference = motionOnlyOnTheGeneralProblem(scene.camera, scene.initialPoses[0], scene.truePoints,
+                                                         scene.observations, referenceOutliers);
+    SE3d pose = scene.initialPoses[0];
+    const MotionOnlyResult result = motionOnlyBundleAdjustment(scene.camera, pose, scene.truePoints, scene.observations);
+    EXPECT_TRUE(sameBits(pose, reference)) << "seed " << seed;
+    EXPECT_EQ(result.outlier, referenceOutliers) << "seed " << seed;
+
+    const SE3d monoReference = motionOnlyOnTheGeneralProblem(scene.camera.pinhole, scene.initialPoses[0],
+                                                             scene.truePoints, scene.observations, referenceOutliers);
+    SE3d monoPose = scene.initialPoses[0];
+    const MotionOnlyResult mono =
+        motionOnlyBundleAdjustment(scene.camera.pinhole, monoPose, scene.truePoints, scene.observations);
+    EXPECT_TRUE(sameBits(monoPose, monoReference)) << "seed " << seed;
+    EXPECT_EQ(mono.outlier, referenceOutliers) << "seed " << seed;
+  }
+}
+
 TEST(OptimSlamBa, LocalBaKeepsFixedKeyframesAndRecoversFreeOnes) {
   bench::SlamSceneSpec spec;
   spec.keyframes = 12;

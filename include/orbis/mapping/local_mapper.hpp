@@ -15,6 +15,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <cstdint>
 #include <functional>
 #include <list>
 #include <mutex>
@@ -73,6 +75,9 @@ class LocalMapper final : public LocalMappingControl {
   void waitUntilIdle();
   // Threaded mode: the same for at most `budget`; true when idle.
   bool waitUntilIdleFor(std::chrono::steady_clock::duration budget);
+  // Threaded mode: block for at most `budget` until every keyframe queued so far has its new map
+  // points (triangulation done; fusion and local BA may still run); true when they have.
+  bool waitUntilTriangulatedFor(std::chrono::steady_clock::duration budget);
   // Finishes queued work and joins the thread.
   void shutdown();
 
@@ -103,6 +108,10 @@ class LocalMapper final : public LocalMappingControl {
   std::function<void(KeyFrame*)> sink_, culledSink_;
 
   std::list<MapPoint*> recentPoints_;
+  // Keyframes queued and keyframes whose new points are made (waitUntilTriangulatedFor).
+  std::mutex triangulatedMutex_;
+  std::condition_variable triangulatedCv_;
+  std::uint64_t queuedTotal_ = 0, triangulatedTotal_ = 0;
   std::atomic<bool> acceptKeyFrames_{true};
   std::atomic<bool> abortBA_{false};
 

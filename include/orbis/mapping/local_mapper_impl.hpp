@@ -31,6 +31,10 @@ void LocalMapper<Sensor>::shutdown() {
 template <SensorConfiguration Sensor>
 void LocalMapper<Sensor>::insertKeyFrame(KeyFrame* kf) {
   abortBA_ = true;
+  {
+    std::lock_guard lock(triangulatedMutex_);
+    ++queuedTotal_;
+  }
   worker_.push(kf);
 }
 
@@ -119,6 +123,13 @@ bool LocalMapper<Sensor>::waitUntilIdleFor(std::chrono::steady_clock::duration b
 }
 
 template <SensorConfiguration Sensor>
+bool LocalMapper<Sensor>::waitUntilTriangulatedFor(std::chrono::steady_clock::duration budget) {
+  std::unique_lock lock(triangulatedMutex_);
+  const std::uint64_t target = queuedTotal_;
+  return triangulatedCv_.wait_for(lock, budget, [&] { return triangulatedTotal_ >= target; });
+}
+
+template <SensorConfiguration Sensor>
 bool LocalMapper<Sensor>::processOne() {
   const std::optional<KeyFrame*> next = worker_.pop();
   if (!next) return false;
@@ -143,6 +154,11 @@ bool LocalMapper<Sensor>::processOne() {
     std::lock_guard lock(map_.mutex());
     createNewMapPoints(kf);
   }
+  {
+    std::lock_guard lock(triangulatedMutex_);
+    ++triangulatedTotal_;
+  }
+  triangulatedCv_.notify_all();
   const bool moreQueued = queuedKeyFrames() > 0;
   if (!moreQueued) {
     {

@@ -247,6 +247,18 @@ class Problem {
     return cost;
   }
 
+  // f(e) for every record index e < count, in chunks of kRecordsPerTask records shared between
+  // the threads; f writes only what belongs to record e, so the order of chunks does not matter.
+  template <class F>
+  void forEachRecordInParallel(std::size_t count, F&& f) {
+    const int chunks = static_cast<int>((count + kRecordsPerTask - 1) / kRecordsPerTask);
+    parallelFor(threads_, chunks, [&](int chunk) {
+      const std::size_t first = static_cast<std::size_t>(chunk) * kRecordsPerTask;
+      const std::size_t last = std::min(count, first + kRecordsPerTask);
+      for (std::size_t e = first; e < last; ++e) f(e);
+    });
+  }
+
   // evaluateCost with the kernel values computed in chunks of records on several threads and
   // summed in record order afterwards: the same cost to the last bit.
   double evaluateCostInParallel(const AlignedVector<Pose>& poses, const AlignedVector<Eigen::Vector3d>& points) {
@@ -256,49 +268,16 @@ class Problem {
       const auto& records = std::get<I>(records_);
       std::vector<double>& rho = recordRho_[I];
       rho.resize(records.size());
-      const int chunks = static_cast<int>((records.size() + kRecordsPerTask - 1) / kRecordsPerTask);
-      parallelFor(threads_, chunks, [&](int chunk) {
-        const std::size_t first = static_cast<std::size_t>(chunk) * kRecordsPerTask;
-        const std::size_t last = std::min(records.size(), first + kRecordsPerTask);
-        for (std::size_t e = first; e < last; ++e) {
-          const auto& rec = records[e];
-          if (!rec.active) continue;
-          const double s = rec.information * rawResidual(rec, poses, points).squaredNorm();
-          rho[e] = Kernel::evaluate(s, rec.delta2).rho;
-        }
+      forEachRecordInParallel(records.size(), [&](std::size_t e) {
+        const auto& rec = records[e];
+        if (!rec.active) return;
+        const double s = rec.information * rawResidual(rec, poses, points).squaredNorm();
+        rho[e] = Kernel::evaluate(s, rec.delta2).rho;
       });
       for (std::size_t e = 0; e < records.size(); ++e)
         if (records[e].active) cost += 0.5 * rho[e];
     });
     return cost;
-  }
-
-  // Whitens r and the Jacobians, then applies the robust correction of Triggs et al. (as in
-  // Ceres' Corrector) so that the Gauss–Newton model matches ρ to second order.
-  template <int R, class... Jacobians>
-  static void whitenAndCorrect(double information, const KernelValue& k, double s,
-                               Eigen::Matrix<double, R, 1>& r, Jacobians*... jacobians) {
-    const double sqrtInfo = std::sqrt(information);
-    r *= sqrtInfo;
-    const double sqrtRho1 = std::sqrt(k.rho1);
-    double residualScale = sqrtRho1;
-    double alphaOverS = 0.0;
-    if (s > 0.0 && k.rho2 > 0.0) {
-      const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * k.rho2 / k.rho1);
-      residualScale = sqrtRho1 / (1.0 - alpha);
-      alphaOverS = alpha / s;
-    }
-    auto correct = [&](auto* jac) {
-      if (!jac) return;
-      *jac *= sqrtInfo;
-      if (alphaOverS != 0.0) {
-        *jac = sqrtRho1 * (*jac - alphaOverS * r * (r.transpose() * *jac));
-      } else {
-        *jac *= sqrtRho1;
-      }
-    };
-    (correct(jacobians), ...);
-    r *= residualScale;
   }
 
   void prepare(const SolverOptions& options);

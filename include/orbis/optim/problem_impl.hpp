@@ -227,24 +227,19 @@ double Problem<PoseM, Terms...>::linearizeInParallel() {
     lin.jPose.resize(records.size());
     lin.jPoint.resize(records.size());
     recordRho_[I].resize(records.size());
-    const int chunks = static_cast<int>((records.size() + kRecordsPerTask - 1) / kRecordsPerTask);
-    parallelFor(threads_, chunks, [&](int chunk) {
-      const std::size_t first = static_cast<std::size_t>(chunk) * kRecordsPerTask;
-      const std::size_t last = std::min(records.size(), first + kRecordsPerTask);
-      for (std::size_t e = first; e < last; ++e) {
-        const auto& rec = records[e];
-        if (!rec.active) continue;
-        const int fp = freePose_[rec.pose], fl = freePoint_[rec.other];
-        ResidualVector<R>& r = lin.residual[e];
-        PoseJacobian<R>* jPose = fp >= 0 ? &lin.jPose[e] : nullptr;
-        PointJacobian<R>* jPoint = fl >= 0 ? &lin.jPoint[e] : nullptr;
-        rec.residual.evaluate(poses_[rec.pose], points_[rec.other], r, jPose, jPoint);
-        const double s = rec.information * r.squaredNorm();
-        const KernelValue k = Kernel::evaluate(s, rec.delta2);
-        recordRho_[I][e] = k.rho;
-        if (fp < 0 && fl < 0) continue;
-        whitenAndCorrect(rec.information, k, s, r, jPose, jPoint);
-      }
+    forEachRecordInParallel(records.size(), [&](std::size_t e) {
+      const auto& rec = records[e];
+      if (!rec.active) return;
+      const int fp = freePose_[rec.pose], fl = freePoint_[rec.other];
+      ResidualVector<R>& r = lin.residual[e];
+      PoseJacobian<R>* jPose = fp >= 0 ? &lin.jPose[e] : nullptr;
+      PointJacobian<R>* jPoint = fl >= 0 ? &lin.jPoint[e] : nullptr;
+      rec.residual.evaluate(poses_[rec.pose], points_[rec.other], r, jPose, jPoint);
+      const double s = rec.information * r.squaredNorm();
+      const KernelValue k = Kernel::evaluate(s, rec.delta2);
+      recordRho_[I][e] = k.rho;
+      if (fp < 0 && fl < 0) return;
+      whitenAndCorrect(rec.information, k, s, r, jPose, jPoint);
     });
   });
   for (auto& h : poseHessian_) h.setZero();

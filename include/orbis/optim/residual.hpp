@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <limits>
 
 namespace orbis::optim {
@@ -81,5 +82,33 @@ struct ResidualId {
   int index = -1;
   // @}
 };
+
+// Whitens r and the Jacobians, then applies the robust correction of Triggs et al. (as in
+// Ceres' Corrector) so that the Gauss–Newton model matches ρ to second order.
+template <int R, class... Jacobians>
+void whitenAndCorrect(double information, const KernelValue& k, double s,
+                      Eigen::Matrix<double, R, 1>& r, Jacobians*... jacobians) {
+  const double sqrtInfo = std::sqrt(information);
+  r *= sqrtInfo;
+  const double sqrtRho1 = std::sqrt(k.rho1);
+  double residualScale = sqrtRho1;
+  double alphaOverS = 0.0;
+  if (s > 0.0 && k.rho2 > 0.0) {
+    const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * k.rho2 / k.rho1);
+    residualScale = sqrtRho1 / (1.0 - alpha);
+    alphaOverS = alpha / s;
+  }
+  auto correct = [&](auto* jac) {
+    if (!jac) return;
+    *jac *= sqrtInfo;
+    if (alphaOverS != 0.0) {
+      *jac = sqrtRho1 * (*jac - alphaOverS * r * (r.transpose() * *jac));
+    } else {
+      *jac *= sqrtRho1;
+    }
+  };
+  (correct(jacobians), ...);
+  r *= residualScale;
+}
 
 }  // namespace orbis::optim

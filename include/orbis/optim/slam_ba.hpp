@@ -20,6 +20,7 @@
 #include <functional>
 
 #include "orbis/optim/bal.hpp"
+#include "orbis/optim/pose_only_problem.hpp"
 #include "orbis/optim/problem.hpp"
 #include "orbis/optim/reprojection.hpp"
 
@@ -130,6 +131,23 @@ struct SlamProblemFor<Camera, Kernel> {
 template <CameraModel Camera, RobustKernel Kernel = HuberKernel>
 using SlamProblem = typename SlamProblemFor<Camera, Kernel>::type;
 
+// The motion-only problem of a camera model: SlamProblem's residual types on one free pose.
+template <CameraModel Camera, RobustKernel Kernel>
+struct MotionOnlyProblemFor {
+  // A monocular and a metric residual.
+  using type = PoseOnlyProblem<Kernel, MonoReprojection, MetricResidual<Camera>>;
+};
+// A monocular camera: one residual type.
+template <CameraModel Camera, RobustKernel Kernel>
+  requires(Camera::kObservationDim == 2)
+struct MotionOnlyProblemFor<Camera, Kernel> {
+  // The monocular residual only.
+  using type = PoseOnlyProblem<Kernel, MonoReprojection>;
+};
+// The motion-only problem type of camera model Camera under kernel Kernel.
+template <CameraModel Camera, RobustKernel Kernel = HuberKernel>
+using MotionOnlyProblem = typename MotionOnlyProblemFor<Camera, Kernel>::type;
+
 // The same problem type with every term's kernel replaced by TrivialKernel.
 template <class P>
 struct WithoutKernelFor;
@@ -201,15 +219,15 @@ MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFr
                                             std::span<const Eigen::Vector3d> pointsWorld,
                                             std::span<const SlamObservation> observations,
                                             const MotionOnlyOptions& options = {}) {
-  SlamProblem<Camera, Kernel> robust;
-  robust.addPose(cameraFromWorld);
-  for (const auto& p : pointsWorld) robust.addPoint(p, /*fixed=*/true);
+  // The same bits as SlamProblem<Camera, Kernel> with the points fixed (and withoutKernel() for
+  // the last rounds), without rebuilding a sparse structure for each round.
+  MotionOnlyProblem<Camera, Kernel> problem(cameraFromWorld, pointsWorld);
   std::vector<ResidualId> ids;
   ids.reserve(observations.size());
   for (const auto& o : observations) {
     SlamObservation single = o;
     single.pose = 0;
-    ids.push_back(slam_detail::addObservation(robust, camera, single, options.chi2Mono, options.chi2Stereo));
+    ids.push_back(slam_detail::addObservation(problem, camera, single, options.chi2Mono, options.chi2Stereo));
   }
   MotionOnlyResult result;
   result.outlier.assign(observations.size(), 0);
@@ -217,9 +235,9 @@ MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFr
   solver.maxIterations = options.iterationsPerRound;
   solver.linearSolver = LinearSolverKind::DenseCholesky;
   const SE3d prior = cameraFromWorld;
-  // One round on either problem; false when too few inliers are left to trust another.
-  auto round = [&](auto& problem) {
-    if (options.restartEachRound) problem.setPose(0, prior);
+  // One round; false when too few inliers are left to trust another.
+  auto round = [&] {
+    if (options.restartEachRound) problem.setPose(prior);
     result.lastRound = problem.solve(solver);
     result.inliers = 0;
     for (std::size_t k = 0; k < observations.size(); ++k) {
@@ -230,15 +248,13 @@ MotionOnlyResult motionOnlyBundleAdjustment(const Camera& camera, SE3d& cameraFr
       problem.setActive(ids[k], !out);
       result.inliers += !out;
     }
-    cameraFromWorld = problem.pose(0);
+    cameraFromWorld = problem.pose();
     return result.inliers >= 10;  // ORB-SLAM's guard
   };
-  int r = 0;
   bool goOn = true;
-  for (; r < std::min(options.rounds, options.robustRounds) && goOn; ++r) goOn = round(robust);
-  if (goOn && r < options.rounds) {
-    auto plain = withoutKernel(robust);
-    for (; r < options.rounds && goOn; ++r) goOn = round(plain);
+  for (int r = 0; r < options.rounds && goOn; ++r) {
+    problem.setRobust(r < options.robustRounds);
+    goOn = round();
   }
   return result;
 }

@@ -44,6 +44,11 @@ struct SlamOptions {
   // keeps the camera's rate; otherwise (frames fed as fast as tracking takes them) it waits
   // until mapping is idle, which costs wall time but no frames.
   bool liveCamera = false;
+  // With a live camera, monocular tracking waits after a keyframe only until mapping has made the
+  // keyframe's new points, and only before it tracks the next frame (false, the default), or
+  // until mapping is idle, local BA included, at most the rest of the frame period (true, as
+  // before issue 35). Why: docs/notes/2026-11-26-speed.md, "Monocular mapping at a live pace".
+  bool liveWaitForLocalBA = false;
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
   // @{
   // The atlas (issue 32; docs/guide/atlas.md): a new map when relocalisation has failed on
@@ -152,6 +157,9 @@ class SlamCore {
  private:
   // Threaded monocular after a new keyframe: waits for local mapping (see the definition).
   void waitForMappingAfterKeyFrame(std::chrono::steady_clock::time_point trackingStart, double extractionMs);
+  // Live monocular: before tracking a frame, wait (at most a frame period) until the keyframe the
+  // frame before made has its new points.
+  void waitForTriangulationOfLastKeyFrame();
   // Threaded monocular with a live camera: that wait is bounded by the frame period, which
   // track() then times from its start.
   bool waitBoundedByFramePeriod() const {
@@ -175,6 +183,7 @@ class SlamCore {
   std::optional<std::uint64_t> initialisedAtFrame_;
   FrameObserver frameObserver_;
   bool shutDown_ = false;
+  bool triangulationPending_ = false;  // waitForTriangulationOfLastKeyFrame has a keyframe to wait for
 };
 
 // The map file's record of a camera model: its pinhole, bf (0 without stereo), close-depth

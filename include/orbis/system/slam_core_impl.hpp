@@ -91,6 +91,7 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
   frame.intrinsics.maxY = features->grid.maxY();
   frame.features = std::move(features);
   TrackResult result;
+  if constexpr (!Sensor::kMetricScale) waitForTriangulationOfLastKeyFrame();
   {
     ScopedStage stage(&timer_, "tracking: total");
     result = tracker_->track(std::move(frame));
@@ -176,19 +177,36 @@ RelocalisationStats SlamCore<Sensor>::relocalisationStats() const {
 // camera (SlamOptions::liveCamera) tracking keeps the camera's rate instead: mapping gets what is
 // left of the frame period (1/fps after extraction and tracking), and tracking runs on if it has
 // not finished. The metric sensors need no wait: each frame measures its own depth. Measurements:
-// docs/notes/2026-11-24-monocular-threaded-wait.md.
+// docs/notes/2026-11-24-monocular-threaded-wait.md. With a live camera (unless
+// SlamOptions::liveWaitForLocalBA) tracking does not wait here at all: the next frame, before it
+// is tracked, waits until this keyframe's new points exist, and local BA runs while the camera
+// delivers frames, as in ORB-SLAM2 (docs/notes/2026-11-26-speed.md).
 template <SensorConfiguration Sensor>
 void SlamCore<Sensor>::waitForMappingAfterKeyFrame(std::chrono::steady_clock::time_point trackingStart,
                                                    double extractionMs) {
   using Clock = std::chrono::steady_clock;
-  ScopedStage stage(&timer_, "tracking: wait for mapping");
   if (!waitBoundedByFramePeriod()) {
+    ScopedStage stage(&timer_, "tracking: wait for mapping");
     mapper_->waitUntilIdle();
     return;
   }
+  if (!options_.liveWaitForLocalBA) {
+    triangulationPending_ = true;  // waited for before the next frame is tracked
+    return;
+  }
+  ScopedStage stage(&timer_, "tracking: wait for mapping");
   const auto period = std::chrono::duration<double>(1.0 / std::max(1.0, options_.fps));
   const auto spent = Clock::now() - trackingStart + std::chrono::duration<double, std::milli>(extractionMs);
   if (spent < period) mapper_->waitUntilIdleFor(std::chrono::duration_cast<Clock::duration>(period - spent));
+}
+
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::waitForTriangulationOfLastKeyFrame() {
+  if (!triangulationPending_) return;
+  triangulationPending_ = false;
+  ScopedStage stage(&timer_, "tracking: wait for mapping");
+  const auto period = std::chrono::duration<double>(1.0 / std::max(1.0, options_.fps));
+  mapper_->waitUntilTriangulatedFor(std::chrono::duration_cast<std::chrono::steady_clock::duration>(period));
 }
 
 template <SensorConfiguration Sensor>
