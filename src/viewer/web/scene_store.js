@@ -108,9 +108,14 @@ class SceneStore {
   }
 
   mapCount() {
+    return this.mapIds().length;
+  }
+
+  // The ids of the maps that hold keyframes, ascending.
+  mapIds() {
     const maps = new Set();
     for (const k of this.keyFrames.values()) maps.add(k.map || 0);
-    return maps.size;
+    return [...maps].sort((a, b) => a - b);
   }
 
   newestKeyFrame() {

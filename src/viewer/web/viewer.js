@@ -21,8 +21,8 @@ const LAYERS = {
   loops: 'loop edges', trajectory: 'trajectory', camera: 'current camera',
 };
 
-window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, live: null, webgl: false,
-                      fullMaps: 0, mapDeltas: 0, renders: 0 };
+window.orbisScene = { keyframes: 0, points: 0, frames: 0, images: 0, loopClosures: 0, maps: 0, merges: 0, live: null,
+                      webgl: false, fullMaps: 0, mapDeltas: 0, renders: 0 };
 const store = new SceneStore();
 const view = { paused: false, frame: null, frameText: null, frameShown: null, fitted: false, frustumSize: 0.05, colouring: 'local',
                mode: 'follow', cameraCentre: null, userMoved: false, recolour: false, pointKey: null };
@@ -133,7 +133,7 @@ function keyFrameLinesOf(map) {
 const lines = {
   keyFrames: new Lines(layers.keyFrames, 0x4aa3ff), covisibility: new Lines(layers.covisibility, 0x3fbf7f, 0.35),
   spanningTree: new Lines(layers.spanningTree, 0xe0c060, 0.8), loops: new Lines(layers.loops, 0xff40a0),
-  trajectory: new Lines(layers.trajectory, 0x40d0e0, 1, true), camera: new Lines(layers.camera, 0x50ff50),
+  trajectory: new Lines(layers.trajectory, 0x40d0e0), camera: new Lines(layers.camera, 0x50ff50),
 };
 const pointMaterial = new THREE.PointsMaterial({ size: 2, sizeAttenuation: false, vertexColors: THREE.VertexColors });
 const pointCloud = { object: null, colours: new Float32Array(0) };
@@ -187,7 +187,7 @@ function colourPoints() {
   const c = pointCloud.colours, local = store.local, n = store.count;
   const byLocalMap = view.colouring === 'local' && local.subarray(0, n).includes(1);
   const byMap = view.colouring === 'map' || (byLocalMap && store.mapCount() > 1);
-  showPointKey(byLocalMap);
+  showPointKey(byLocalMap, byMap ? store.mapIds() : []);
   const newest = store.newestKeyFrame();
   const colours = new Map();
   const colourOf = (firstKeyFrame) => {
@@ -238,10 +238,23 @@ function drawKeyFrames() {
   for (const l of [keyFrames, covisibility, spanningTree, loops, ...mapLines()]) l.end();
 }
 
+// Consecutive tracked cameras joined, except across a jump: a new map of the atlas starts in a
+// frame of its own (until it is merged), and nothing was tracked across a loss, so a step longer
+// than this many times the median step is left open rather than drawn as a straight line.
+const TRAJECTORY_JUMP_STEPS = 20;
+
 function drawTrajectory() {
   const t = store.trajectory;
+  const step = (i) => Math.hypot(t[i + 3] - t[i], t[i + 4] - t[i + 1], t[i + 5] - t[i + 2]);
+  const steps = [];
+  for (let i = 0; i + 5 < t.length; i += 3) steps.push(step(i));
+  const median = steps.length ? [...steps].sort((a, b) => a - b)[steps.length >> 1] : 0;
   lines.trajectory.begin();
-  for (let i = 0; i + 2 < t.length; i += 3) lines.trajectory.vertex(t[i], t[i + 1], t[i + 2]);
+  for (let i = 0, k = 0; i + 5 < t.length; i += 3, ++k) {
+    if (steps[k] > TRAJECTORY_JUMP_STEPS * median) continue;
+    lines.trajectory.vertex(t[i], t[i + 1], t[i + 2]);
+    lines.trajectory.vertex(t[i + 3], t[i + 4], t[i + 5]);
+  }
   lines.trajectory.end();
 }
 
@@ -307,7 +320,8 @@ function drawMap() {
   const keyFramesChanged = store.keyFramesChanged;
   store.pointsChanged = store.keyFramesChanged = store.trajectoryChanged = view.recolour = false;
   Object.assign(window.orbisScene, { keyframes: store.keyFrames.size, points: store.count,
-                                     loopClosures: store.loopClosures.length, live: store.live });
+                                     loopClosures: store.loopClosures.length, maps: store.mapCount(),
+                                     merges: store.merges.length, live: store.live });
   window.orbisScene.frames = Math.max(window.orbisScene.frames, store.frames);
   announceLoops(store.loopClosures);
   announceMerges(store.merges);
@@ -448,12 +462,20 @@ function buildControls() {
 }
 
 // The points' colours as colourPoints chose them, beside the choice of colouring.
-function showPointKey(byLocalMap) {
-  if (byLocalMap === view.pointKey) return;
-  view.pointKey = byLocalMap;
-  ui('point-key').innerHTML = byLocalMap
-    ? '<span class="dot" style="background:#ff4040"></span>local map<span class="dot" style="background:#bfc7d9"></span>other'
-    : '<span class="dot" style="background:#4073ff"></span>oldest keyframe<span class="dot" style="background:#ffd933"></span>newest';
+// The key under the colouring menu: local map and the rest, each map's colour, or the age ramp.
+function showPointKey(byLocalMap, maps = []) {
+  const key = `${byLocalMap}:${maps.join(',')}`;
+  if (key === view.pointKey) return;
+  view.pointKey = key;
+  const dot = (colour, label) => `<span class="dot" style="background:${colour}"></span>${label}`;
+  const local = byLocalMap ? dot('#ff4040', 'local map') : '';
+  if (maps.length) {
+    ui('point-key').innerHTML = local + maps.map((m) => dot(
+      '#' + mapColour(m).lerp(new THREE.Color(0xffffff), 0.25).getHexString(), `map ${m}`)).join('');
+  } else {
+    ui('point-key').innerHTML = byLocalMap ? local + dot('#bfc7d9', 'other')
+      : dot('#4073ff', 'oldest keyframe') + dot('#ffd933', 'newest');
+  }
 }
 
 // ?view=follow|free|top in the address picks the camera mode at the start.
@@ -467,12 +489,14 @@ function applyQuery() {
 
 // Each connection starts from an empty scene: the server sends the whole map or every change.
 // The stream closes by itself once the run has finished (its map will not change), or, with
-// ?maps=N in the address, after N map messages, or with ?loops=N after the map that shows the
-// N-th loop closure: a headless browser takes its screenshot once no request is open.
+// ?maps=N in the address, after N map messages, or with ?loops=N (?merges=N) after the map that
+// shows the N-th loop closure (merge of two maps of the atlas): a headless browser takes its
+// screenshot once no request is open.
 function connect() {
   const query = new URLSearchParams(location.search);
   const closeAfterMaps = Number(query.get('maps')) || Infinity;
   const closeAfterLoops = Number(query.get('loops')) || Infinity;
+  const closeAfterMerges = Number(query.get('merges')) || Infinity;
   let maps = 0;
   const events = new EventSource('events');
   events.onopen = () => store.reset();
@@ -489,7 +513,10 @@ function connect() {
     }
     window.orbisScene[message.full ? 'fullMaps' : 'mapDeltas']++;
     streamed(false, true);
-    if (!store.live || ++maps >= closeAfterMaps || store.loopClosures.length >= closeAfterLoops) events.close();
+    if (!store.live || ++maps >= closeAfterMaps || store.loopClosures.length >= closeAfterLoops ||
+        store.merges.length >= closeAfterMerges) {
+      events.close();
+    }
   });
   events.onerror = () => setText('mode', '— disconnected (retrying)');
 }
