@@ -161,11 +161,10 @@ class MonocularFeatureBuilder {
   FrameFeatures build(const MonocularInput& in) {
     return keypointsOf_(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image);
   }
-  // @{
-  // Whether the builder uses the initialisation budget (set by the tracker's owner).
+  // Switches the initialisation budget on or off (the tracker's owner does).
   void setInitialising(bool initialising) { isInitialising_ = initialising; }
+  // Whether the builder uses the initialisation budget.
   bool initialising() const { return isInitialising_; }
-  // @}
 
  private:
   static OrbParams initialisationParams(OrbParams orb) {
