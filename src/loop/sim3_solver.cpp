@@ -16,6 +16,10 @@ namespace {
 
 using Sim3Problem = optim::Problem<optim::Sim3Manifold, optim::Term<optim::MonoSim3Reprojection, optim::HuberKernel>,
                                    optim::Term<optim::MonoInverseSim3Reprojection, optim::HuberKernel>>;
+using Lens = KannalaBrandtCamera<double>;
+using LensSim3Problem =
+    optim::Problem<optim::Sim3Manifold, optim::Term<optim::Sim3Reprojection<Lens>, optim::HuberKernel>,
+                   optim::Term<optim::InverseSim3Reprojection<Lens>, optim::HuberKernel>>;
 
 // Centred points spread along at least two directions: the second largest eigenvalue of their
 // scatter is not negligible against the largest (collinear or coincident sets leave a rotation
@@ -73,6 +77,10 @@ PairChi2 pairChi2(const PinholeCamera<double>& camera, const Sim3d& S12, const P
   return detail::twoWayChi2(camera, S12, pair);
 }
 
+PairChi2 pairChi2(const KannalaBrandtCamera<double>& lens, const Sim3d& S12, const PointPair& pair) {
+  return detail::twoWayChi2(lens, S12, pair);
+}
+
 Sim3Estimate estimateSim3Ransac(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera,
                                 const Sim3RansacOptions& options, std::mt19937& rng) {
   const auto fit = [&](const Eigen::Matrix3Xd& source, const Eigen::Matrix3Xd& target) {
@@ -101,6 +109,12 @@ int refineSim3(const std::vector<PointPair>& pairs, const PinholeCamera<double>&
                std::vector<char>& inliers, double outlierChi2) {
   return detail::refineTwoWay<Sim3Problem, optim::MonoSim3Reprojection, optim::MonoInverseSim3Reprojection>(
       pairs, camera, S12, inliers, outlierChi2);
+}
+
+int refineSim3(const std::vector<PointPair>& pairs, const KannalaBrandtCamera<double>& lens, Sim3d& S12,
+               std::vector<char>& inliers, double outlierChi2) {
+  return detail::refineTwoWay<LensSim3Problem, optim::Sim3Reprojection<Lens>, optim::InverseSim3Reprojection<Lens>>(
+      pairs, lens, S12, inliers, outlierChi2);
 }
 
 }  // namespace orbis::loop

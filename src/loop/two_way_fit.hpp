@@ -2,7 +2,8 @@
 // 3-pair closed forms and the two-way reprojection refinement, generic over the transform.
 //
 // Contract (private to src/loop/): a Transform is SE3d or Sim3d with a pairChi2(camera, T, pair)
-// overload; the pairs and their meaning are relative_pose.hpp's. ransacOverTriples draws three
+// overload, the camera a pinhole (or, for the Sim(3) refinement, a fisheye lens, the pairs'
+// keypoints then in its pixels); the pairs and their meaning are relative_pose.hpp's. ransacOverTriples draws three
 // distinct indices per hypothesis as rng() % n (identical on every standard library), fits them
 // with fitTriple (nullopt: degenerate, skipped), counts inliers with `score`, stops after
 // `iterations` or once `needed(bestCount)` hypotheses have been drawn, then refits the best
@@ -24,12 +25,12 @@
 namespace orbis::loop::detail {
 
 // The pair's χ² in camera 1 (its point 2 through T) and in camera 2 (its point 1 through T⁻¹).
-template <class Transform>
-PairChi2 twoWayChi2(const PinholeCamera<double>& camera, const Transform& T12, const PointPair& pair) {
+template <class Camera, class Transform>
+PairChi2 twoWayChi2(const Camera& camera, const Transform& T12, const PointPair& pair) {
   const Eigen::Vector3d q1 = T12 * pair.p2;            // point 2 seen by camera 1
   const Eigen::Vector3d q2 = T12.inverse() * pair.p1;  // point 1 seen by camera 2
   PairChi2 out;
-  if (!PinholeCamera<double>::inFront(q1) || !PinholeCamera<double>::inFront(q2)) return out;
+  if (!Camera::inFront(q1) || !Camera::inFront(q2)) return out;
   out.chi2First = (camera.project(q1) - pair.obs1).squaredNorm() * pair.information1;
   out.chi2Second = (camera.project(q2) - pair.obs2).squaredNorm() * pair.information2;
   out.valid = true;
@@ -38,8 +39,8 @@ PairChi2 twoWayChi2(const PinholeCamera<double>& camera, const Transform& T12, c
 
 // Flags the pairs within `chi2` in both images (only among those already flagged when
 // `keepOutliersOut`); returns how many.
-template <class Transform>
-int classify(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera, const Transform& T, double chi2,
+template <class Camera, class Transform>
+int classify(const std::vector<PointPair>& pairs, const Camera& camera, const Transform& T, double chi2,
              bool keepOutliersOut, std::vector<char>& inliers) {
   int count = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -115,8 +116,8 @@ RansacResult<Transform> ransacOverTriples(const std::vector<PointPair>& pairs, i
   return best;
 }
 
-template <class Problem, class Direct, class Inverse, class Transform>
-void refineOnFlagged(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera, Transform& T,
+template <class Problem, class Direct, class Inverse, class Camera, class Transform>
+void refineOnFlagged(const std::vector<PointPair>& pairs, const Camera& camera, Transform& T,
                      const std::vector<char>& use, double huberChi2, int iterations) {
   Problem problem;
   problem.addPose(T);
@@ -136,8 +137,8 @@ void refineOnFlagged(const std::vector<PointPair>& pairs, const PinholeCamera<do
   T = problem.pose(0);
 }
 
-template <class Problem, class Direct, class Inverse, class Transform>
-int refineTwoWay(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera, Transform& T,
+template <class Problem, class Direct, class Inverse, class Camera, class Transform>
+int refineTwoWay(const std::vector<PointPair>& pairs, const Camera& camera, Transform& T,
                  std::vector<char>& inliers, double outlierChi2) {
   inliers.resize(pairs.size(), 0);
   refineOnFlagged<Problem, Direct, Inverse>(pairs, camera, T, inliers, outlierChi2, 5);

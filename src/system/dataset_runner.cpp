@@ -218,7 +218,9 @@ bool inputComplete(const MonocularInput& in) { return !in.image.empty(); }
 template <class Sensor, class Lens>
 Slam<Sensor> makeSlam(const typename Sensor::Camera& camera, const OrbParams& orb, const Lens& lens,
                       std::shared_ptr<const OrbVocabulary> vocabulary, const SlamOptions& options) {
-  if constexpr (Sensor::kKind == SensorKind::Monocular) return Slam<Sensor>(camera, orb, lens, std::move(vocabulary), options);
+  if constexpr (std::constructible_from<typename Sensor::FeatureBuilder, const typename Sensor::Camera&, const OrbParams&,
+                                        const Lens&>)
+    return Slam<Sensor>(camera, orb, lens, std::move(vocabulary), options);
   else return Slam<Sensor>(camera, orb, std::move(vocabulary), options);
 }
 
@@ -591,7 +593,7 @@ RunReport runFrames(FrameSource& rawSource, const RunOptions& options, const Def
                   "a KannalaBrandt8 camera runs at its calibrated image size: drop --resize / Camera.newWidth, or "
                   "calibrate the camera at the size the frames come in");
     report.sensor += " (fisheye)";
-    runWith<MonocularFisheye>(MonocularFisheye::planeOf(*fisheye), *fisheye, orb, fps, in, options, report);
+    runWith<MonocularFisheye>(MonocularFisheye::cameraOf(*fisheye), *fisheye, orb, fps, in, options, report);
     return report;
   }
   std::visit(

@@ -2,12 +2,14 @@
 // update), on random well-conditioned configurations. The maximum discrepancy is printed.
 #include "jacobian_check.hpp"
 
+#include "orbis/camera/kannala_brandt.hpp"
 #include "orbis/optim/pose_graph_residuals.hpp"
 #include "orbis/optim/reprojection.hpp"
 #include "orbis/optim/sim3_reprojection.hpp"
 
 #include <gtest/gtest.h>
 
+#include <numbers>
 #include <random>
 
 namespace orbis::optim {
@@ -169,6 +171,44 @@ TEST(OptimResiduals, Sim3ReprojectionJacobians) {
   std::printf("InverseSim3Reprojection (2x7x3): max relative discrepancy %.3e\n", worstInverse);
   EXPECT_LT(worstDirect, 1e-6);
   EXPECT_LT(worstInverse, 1e-6);
+}
+
+// A direction up to maxDegrees off the camera's axis, 2–10 m away, in the world.
+Eigen::Vector3d pointOffAxis(std::mt19937& rng, double maxDegrees, const SE3d& cameraFromWorld) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double theta = maxDegrees * std::numbers::pi / 180 * u(rng), azimuth = 2 * std::numbers::pi * u(rng);
+  const Eigen::Vector3d ray(std::sin(theta) * std::cos(azimuth), std::sin(theta) * std::sin(azimuth), std::cos(theta));
+  return cameraFromWorld.inverse() * ((2.0 + 8.0 * u(rng)) * ray);
+}
+
+// The fisheye sensor's residuals in lens pixels (MonocularFisheye's BA and Sim(3) refinement):
+// the generic reprojections on the Kannala–Brandt lens, for points up to 100 degrees off axis.
+TEST(OptimResiduals, KannalaBrandtReprojectionJacobians) {
+  KannalaBrandtCamera<double> lens;
+  lens.fx = 199.7, lens.fy = 201.3, lens.cx = 320, lens.cy = 240;
+  lens.k1 = 0.01, lens.k2 = -0.002, lens.k3 = 0.0005, lens.k4 = -0.0001;
+  lens.width = 640, lens.height = 480;
+  std::mt19937 rng(17);
+  double worstPose = 0, worstSim3 = 0, worstInverseSim3 = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const SE3d pose = randomPose(rng, 0.8, 1.0);
+    const Reprojection<KannalaBrandtCamera<double>> residual{{300.0, 200.0}, &lens};
+    worstPose = std::max(worstPose, test::checkJacobians(residual, pose, pointOffAxis(rng, 100, pose)).relative());
+    const Sim3d S12 = randomSim3(rng, 0.7, 1.0, 0.3);
+    const Sim3Reprojection<KannalaBrandtCamera<double>> direct{{150.0, 110.0}, &lens};
+    const InverseSim3Reprojection<KannalaBrandtCamera<double>> inverse{{170.0, 100.0}, &lens};
+    // Camera 1 sees S12·p (p in camera 2) and camera 2 sees S12⁻¹·p (p in camera 1), each up to
+    // 100 degrees off its axis.
+    const Eigen::Vector3d seenBy1 = pointOffAxis(rng, 100, SE3d());
+    worstSim3 = std::max(worstSim3, test::checkJacobians(direct, S12, S12.inverse() * seenBy1).relative());
+    const Eigen::Vector3d seenBy2 = pointOffAxis(rng, 100, SE3d());
+    worstInverseSim3 = std::max(worstInverseSim3, test::checkJacobians(inverse, S12, S12 * seenBy2).relative());
+  }
+  std::printf("Reprojection<KannalaBrandt> (2x6x3): max relative discrepancy %.3e\n", worstPose);
+  std::printf("Sim3Reprojection<KannalaBrandt> (2x7x3): %.3e, inverse %.3e\n", worstSim3, worstInverseSim3);
+  EXPECT_LT(worstPose, 1e-6);
+  EXPECT_LT(worstSim3, 1e-6);
+  EXPECT_LT(worstInverseSim3, 1e-6);
 }
 
 // With scale 1 the Sim(3) residuals are the SE(3) ones: same values, and the first six Jacobian

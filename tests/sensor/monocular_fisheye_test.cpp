@@ -11,8 +11,7 @@ namespace orbis {
 namespace {
 
 static_assert(SensorConfiguration<MonocularFisheye>);
-static_assert(std::same_as<PipelineSensor<MonocularFisheye>, Monocular>);
-static_assert(std::same_as<PipelineSensor<Stereo>, Stereo>);
+static_assert(ObservesThroughLens<MonocularFisheye::Camera> && !ObservesThroughLens<Monocular::Camera>);
 
 TEST(MonocularFisheyeSensor, KeypointsOnTheTangentPlane) {
   synth::SynthOptions o;
@@ -23,12 +22,13 @@ TEST(MonocularFisheyeSensor, KeypointsOnTheTangentPlane) {
   synth::SyntheticSequence sequence(o);
   const KannalaBrandtCamera<double> lens = sequence.fisheyeCamera();
   const MonocularInput input{0.0, sequence.render(10, false, false).left};
-  MonocularFisheye::FeatureBuilder builder(MonocularFisheye::planeOf(lens), OrbParams{}, lens, 70.0);
+  const MonocularFisheye::Camera camera = MonocularFisheye::cameraOf(lens);
+  MonocularFisheye::FeatureBuilder builder(camera, OrbParams{}, 70.0);
   const FrameFeatures f = builder.build(input);
   ASSERT_GT(f.size(), 300u);
   ASSERT_EQ(f.keypointsUn.size(), f.size());
   ASSERT_EQ(f.descriptors.size(), f.size());
-  const PinholeCamera<double> plane = MonocularFisheye::planeOf(lens);
+  const PinholeCamera<double>& plane = camera.pinhole;
   double widest = 0;
   for (std::size_t i = 0; i < f.size(); ++i) {
     const Eigen::Vector3d ray = lens.bearing(Eigen::Vector2d(f.keypoints[i].u, f.keypoints[i].v));
@@ -45,8 +45,16 @@ TEST(MonocularFisheyeSensor, KeypointsOnTheTangentPlane) {
               widest, f.grid.minX(), f.grid.maxX(), f.grid.minY(), f.grid.maxY());
   EXPECT_GT(widest, 55.0);  // the periphery is used, not only a pinhole-sized centre
   // A narrower cut keeps fewer.
-  MonocularFisheye::FeatureBuilder narrow(plane, OrbParams{}, lens, 45.0);
+  MonocularFisheye::FeatureBuilder narrow(camera, OrbParams{}, 45.0);
   EXPECT_LT(narrow.build(input).size(), f.size());
+  // The default reaches further out, and the builder keeps Monocular's initialisation budget.
+  MonocularFisheye::FeatureBuilder wide(camera, OrbParams{});
+  EXPECT_TRUE(wide.initialising());
+  const std::size_t initialising = wide.build(input).size();
+  wide.setInitialising(false);
+  const std::size_t tracking = wide.build(input).size();
+  EXPECT_GT(initialising, f.size());  // both with the initialisation budget, 80 against 70 degrees
+  EXPECT_GT(initialising, tracking);
 }
 
 }  // namespace

@@ -65,6 +65,7 @@ struct ProjectionQuery {
   float viewCos = 1.f;   // cosine between this view's ray and the point's mean viewing direction
   // The point's descriptor.
   OrbDescriptor descriptor;
+  float windowStretch = 1.f;  // the window's widening by the camera's lens there (1: none)
 };
 
 namespace detail {
@@ -176,7 +177,7 @@ int searchByProjection(const FrameFeatures& frame, std::span<const ProjectionQue
     const int level = std::clamp(query.octave, 0, frame.scales.levels() - 1);
     // Viewing almost along the mean direction: appearance is reliable, search tighter.
     const float base = query.viewCos > 0.998f ? 2.5f : 4.f;
-    const float r = base * th * frame.scales.scale[static_cast<std::size_t>(level)];
+    const float r = base * th * frame.scales.scale[static_cast<std::size_t>(level)] * query.windowStretch;
     frame.grid.featuresInArea(query.u, query.v, r, level - 1, level, candidates);
     const NearestTwo n = nearestTwo(
         frame, query.descriptor, candidates,

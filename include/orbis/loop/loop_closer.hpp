@@ -53,6 +53,7 @@
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
 #include "orbis/map/slam_events.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/util/queue_worker.hpp"
 #include "orbis/util/timing.hpp"
@@ -209,4 +210,5 @@ namespace orbis {
 extern template class LoopCloser<Stereo>;
 extern template class LoopCloser<Rgbd>;
 extern template class LoopCloser<Monocular>;
+extern template class LoopCloser<MonocularFisheye>;
 }  // namespace orbis

@@ -253,6 +253,21 @@ inline int refine(const std::vector<loop::PointPair>& pairs, const PinholeCamera
   return loop::refineSim3(pairs, camera, S12, inliers);
 }
 
+// The refinement on the camera's pinhole, or through its lens for a camera that observes
+// through one (the keypoints moved to the lens's pixels, where their noise is isotropic).
+template <CameraModel Camera, class Transform>
+int refine(const Camera& camera, std::vector<loop::PointPair>& pairs, Transform& T12, std::vector<char>& inliers) {
+  if constexpr (ObservesThroughLens<Camera>) {
+    for (loop::PointPair& p : pairs) {
+      p.obs1 = camera.lensPixel(p.obs1);
+      p.obs2 = camera.lensPixel(p.obs2);
+    }
+    return loop::refineSim3(pairs, camera.lens, T12, inliers);
+  } else {
+    return refine(pairs, pinholeOf(camera), T12, inliers);
+  }
+}
+
 }  // namespace loop_detail
 
 template <SensorConfiguration Sensor>
@@ -301,7 +316,7 @@ bool LoopCloser<Sensor>::loopTransform(KeyFrame* kf, KeyFrame* candidate, const 
   }
   loop_detail::pairsFromMatches(*kf, *candidate, guided, pairs, index1);
   inliers.assign(pairs.size(), 1);
-  if (loop_detail::refine(pairs, pinhole, T12, inliers) < options_.minPoseInliers) return false;
+  if (loop_detail::refine(camera_, pairs, T12, inliers) < options_.minPoseInliers) return false;
   out.loopKeyFrame = candidate;
   if constexpr (Sensor::kMetricScale) {
     out.correctedTcw = T12 * candidate->Tcw();

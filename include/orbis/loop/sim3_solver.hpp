@@ -20,7 +20,8 @@
 //    optim::InverseSim3Reprojection into camera 2, Huber at √outlierChi2 σ) minimised by the
 //    library's Levenberg–Marquardt over S12 with the points fixed, twice, dropping after the first
 //    round the pairs whose χ² exceeds outlierChi2 in either image; returns the inliers left.
-//    Bit-identical for identical inputs.
+//    Bit-identical for identical inputs. Its fisheye overload takes the pairs' keypoints in the
+//    lens's pixels and projects through the lens (the MonocularFisheye sensor's loops).
 #pragma once
 
 #include <optional>
@@ -29,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include "orbis/camera/kannala_brandt.hpp"
 #include "orbis/camera/pinhole.hpp"
 #include "orbis/geometry/sim3.hpp"
 #include "orbis/loop/relative_pose.hpp"
@@ -40,6 +42,8 @@ std::optional<Sim3d> alignSim3(const Eigen::Matrix3Xd& source, const Eigen::Matr
 
 // A pair's χ² in each image through S12 (see PairChi2); not valid behind either camera.
 PairChi2 pairChi2(const PinholeCamera<double>& camera, const Sim3d& S12, const PointPair& pair);
+// The same through a fisheye lens, the pair's keypoints in its pixels.
+PairChi2 pairChi2(const KannalaBrandtCamera<double>& lens, const Sim3d& S12, const PointPair& pair);
 
 // The Sim(3) RANSAC of loop detection (ORB-SLAM2's Sim3Solver).
 struct Sim3RansacOptions {
@@ -71,6 +75,9 @@ Sim3Estimate estimateSim3Ransac(const std::vector<PointPair>& pairs, const Pinho
 
 // Refines S12 over the pairs flagged in `inliers` and rewrites the flags.
 int refineSim3(const std::vector<PointPair>& pairs, const PinholeCamera<double>& camera, Sim3d& S12,
+               std::vector<char>& inliers, double outlierChi2 = 10.0);
+// The same through a fisheye lens, the pairs' keypoints in its pixels.
+int refineSim3(const std::vector<PointPair>& pairs, const KannalaBrandtCamera<double>& lens, Sim3d& S12,
                std::vector<char>& inliers, double outlierChi2 = 10.0);
 
 }  // namespace orbis::loop

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "orbis/camera/camera_model.hpp"
+#include "orbis/camera/fisheye_plane_camera.hpp"
 #include "orbis/geometry/sim3.hpp"
 #include "orbis/map/map.hpp"
 

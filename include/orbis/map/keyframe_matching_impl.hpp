@@ -16,12 +16,13 @@ namespace keyframe_detail {
 
 // Where a point seen from pose Tcw should appear in `kf`, and the pyramid level it predicts;
 // false when it is behind the camera, off the image or outside its scale-invariance range.
+// windowStretch: how much the camera's lens widens a matching window there (1: no lens).
 // Tcw is an SE3d, or a Sim3d taking another keyframe's world (its map scale) into this camera:
 // its inverse's translation is still the camera centre in that world, where the point's scale-
 // invariance distances were measured.
 template <CameraModel Camera, class Pose>
 bool predict(const Camera& camera, const KeyFrame& kf, const Pose& Tcw, const Eigen::Vector3d& world,
-             const MapPoint& point, float& u, float& v, int& level, bool checkViewAngle) {
+             const MapPoint& point, float& u, float& v, int& level, float& windowStretch, bool checkViewAngle) {
   const Eigen::Vector3d pc = Tcw * world;
   if (pc.z() <= 0) return false;
   const Eigen::Vector2d xy = pinholeOf(camera).project(pc);
@@ -36,6 +37,7 @@ bool predict(const Camera& camera, const KeyFrame& kf, const Pose& Tcw, const Ei
   level = point.predictScale(dist, levels.levels(), levels.logFactor());
   u = static_cast<float>(x);
   v = static_cast<float>(y);
+  windowStretch = searchWindowStretch(camera, pc);
   return true;
 }
 
@@ -96,10 +98,10 @@ int matchBothWays(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2
   for (std::size_t j = 0; j < kf2.size(); ++j) {
     MapPoint* p = kf2.point(j);
     if (!p || p->isBad() || alreadyMatched.count(p)) continue;
-    float u, v;
+    float u, v, stretch;
     int level;
-    if (!predict(camera, kf1, T1w_via2, p->position(), *p, u, v, level, false)) continue;
-    const long i = bestInArea(kf1, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (!predict(camera, kf1, T1w_via2, p->position(), *p, u, v, level, stretch, false)) continue;
+    const long i = bestInArea(kf1, u, v, level, radius * stretch, p->descriptor(), kThHigh, nullptr);
     if (i >= 0 && !matches12[static_cast<std::size_t>(i)]) match1to2[static_cast<std::size_t>(i)] = static_cast<long>(j);
   }
   // kf1's points into kf2; keep the pairs both directions chose.
@@ -107,10 +109,10 @@ int matchBothWays(const Camera& camera, const KeyFrame& kf1, const KeyFrame& kf2
   for (std::size_t i = 0; i < kf1.size(); ++i) {
     MapPoint* p = kf1.point(i);
     if (!p || p->isBad() || matches12[i] || match1to2[i] < 0) continue;
-    float u, v;
+    float u, v, stretch;
     int level;
-    if (!predict(camera, kf2, T2w_via1, p->position(), *p, u, v, level, false)) continue;
-    const long j = bestInArea(kf2, u, v, level, radius, p->descriptor(), kThHigh, nullptr);
+    if (!predict(camera, kf2, T2w_via1, p->position(), *p, u, v, level, stretch, false)) continue;
+    const long j = bestInArea(kf2, u, v, level, radius * stretch, p->descriptor(), kThHigh, nullptr);
     if (j != match1to2[i]) continue;
     matches12[i] = kf2.point(static_cast<std::size_t>(j));
     ++added;
@@ -149,10 +151,10 @@ int matchByProjection(const Camera& camera, const KeyFrame& kf, const SE3d& Tcw,
   int added = 0;
   for (MapPoint* p : points) {
     if (!p || p->isBad() || alreadyMatched.count(p)) continue;
-    float u, v;
+    float u, v, stretch;
     int level;
-    if (!keyframe_detail::predict(camera, kf, Tcw, p->position(), *p, u, v, level, true)) continue;
-    const long i = keyframe_detail::bestInArea(kf, u, v, level, radius, p->descriptor(), kThLow, &matches);
+    if (!keyframe_detail::predict(camera, kf, Tcw, p->position(), *p, u, v, level, stretch, true)) continue;
+    const long i = keyframe_detail::bestInArea(kf, u, v, level, radius * stretch, p->descriptor(), kThLow, &matches);
     if (i < 0) continue;
     matches[static_cast<std::size_t>(i)] = p;
     alreadyMatched.insert(p);

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include "orbis/camera/fisheye_plane_camera.hpp"
 #include "orbis/features/matcher.hpp"  // the search kernels, kThHigh, kThLow, RotationHistogram
 #include "orbis/map/map.hpp"
 #include "orbis/map/frame.hpp"
@@ -37,6 +38,8 @@ struct Projection {
   int level = 0;
   // Cosine between the ray and the point's mean viewing direction.
   float viewCos = 1;
+  // The matching window's widening by the camera's lens there (searchWindowStretch).
+  float windowStretch = 1;
 };
 // Predicts where a map point appears in a frame at pose Tcw; false outside the frustum, the
 // distance range or 60° of the mean direction.

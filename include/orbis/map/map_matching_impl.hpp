@@ -31,6 +31,20 @@ Eigen::Vector3d projectWithRight(const Camera& camera, const Eigen::Vector3d& pc
   }
 }
 
+// Where a camera's pixel noise is isotropic: the observation itself, or for a camera observing
+// through a lens the lens pixel of the plane observation (of the camera-frame point pc whose plane
+// projection is planePx).
+template <CameraModel Camera>
+Eigen::Vector2d noisePixel(const Camera& camera, const Eigen::Vector2d& planePx) {
+  if constexpr (ObservesThroughLens<Camera>) return camera.lensPixel(planePx);
+  else return planePx;
+}
+template <CameraModel Camera>
+Eigen::Vector2d noisePixel(const Camera& camera, const Eigen::Vector3d& pc, const Eigen::Vector2d& planePx) {
+  if constexpr (ObservesThroughLens<Camera>) return camera.lens.project(pc);
+  else return planePx;
+}
+
 }  // namespace detail
 
 template <CameraModel Camera>
@@ -53,6 +67,7 @@ bool projectIntoFrame(const Camera& camera, const MapIntrinsics& bounds, const M
   out.uRight = StereoCameraModel<Camera> ? static_cast<float>(obs.z()) : -1.f;
   out.level = point.predictScale(dist, levels.levels(), levels.logFactor());
   out.viewCos = viewCos;
+  out.windowStretch = searchWindowStretch(camera, pc);
   return true;
 }
 
@@ -82,7 +97,7 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
     const float v = static_cast<float>(obs.y());
     if (!current.intrinsics.inImage(u, v)) continue;
     const int lastOctave = last.features->keypointsUn[i].octave;
-    const float r = radius * levels.scale[static_cast<std::size_t>(lastOctave)];
+    const float r = radius * levels.scale[static_cast<std::size_t>(lastOctave)] * searchWindowStretch(*current.camera, pc);
     int minLevel = lastOctave - 1, maxLevel = lastOctave + 1;
     if (forward) { minLevel = lastOctave; maxLevel = levels.levels() - 1; }
     else if (backward) { minLevel = 0; maxLevel = lastOctave; }
@@ -116,7 +131,7 @@ int matchLocalPoints(Frame<Camera>& frame, const std::vector<MapPoint*>& points,
     MapPoint* p = points[k];
     if (!p || p->isBad()) continue;
     const Projection& pr = projections[k];
-    queries.push_back({pr.u, pr.v, pr.uRight, pr.level, pr.viewCos, p->descriptor()});
+    queries.push_back({pr.u, pr.v, pr.uRight, pr.level, pr.viewCos, p->descriptor(), pr.windowStretch});
     queried.push_back(p);
   }
   std::vector<std::uint8_t> taken(frame.size());
@@ -177,7 +192,7 @@ int matchFromKeyFrame(Frame<Camera>& frame, const KeyFrame& kf, const std::set<M
     const float dist = static_cast<float>((p->position() - center).norm());
     if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;
     const int level = p->predictScale(dist, f.scales.levels(), f.scales.logFactor());
-    const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
+    const float r = radius * f.scales.scale[static_cast<std::size_t>(level)] * searchWindowStretch(*frame.camera, pc);
     f.grid.featuresInArea(u, v, r, level - 1, level + 1, candidates);
     const NearestTwo n = nearestTwo(f, p->descriptor(), candidates, [&](std::size_t j) { return frame.points[j] != nullptr; });
     if (n.best >= 0 && n.bestDistance <= maxDistance) {
@@ -248,14 +263,17 @@ int fuse(const Camera& camera, KeyFrame& kf, const std::vector<MapPoint*>& point
     if (dist < p->minDistanceInvariance() || dist > p->maxDistanceInvariance()) continue;
     if (p->normal().norm() > 0 && po.dot(p->normal()) < 0.5 * dist * p->normal().norm()) continue;
     const int level = p->predictScale(dist, f.scales.levels(), f.scales.logFactor());
-    const float r = radius * f.scales.scale[static_cast<std::size_t>(level)];
+    const float r = radius * f.scales.scale[static_cast<std::size_t>(level)] * searchWindowStretch(camera, pc);
     f.grid.featuresInArea(static_cast<float>(u), static_cast<float>(v), r, -1, -1, candidates);
     // Candidates on the predicted level or the one below whose reprojection error passes χ²
-    // at 95% (2 degrees of freedom, 3 with a right coordinate).
+    // at 95% (2 degrees of freedom, 3 with a right coordinate), in the lens's pixels for a
+    // camera that observes through one.
+    const Eigen::Vector2d predicted = detail::noisePixel(camera, pc, Eigen::Vector2d(u, v));
     const auto reprojectionTooFar = [&](std::size_t j) {
       const Keypoint& k = f.keypointsUn[j];
       if (k.octave < level - 1 || k.octave > level) return true;
-      const double ex = u - k.u, ey = v - k.v;
+      const Eigen::Vector2d measured = detail::noisePixel(camera, Eigen::Vector2d(k.u, k.v));
+      const double ex = predicted.x() - measured.x(), ey = predicted.y() - measured.y();
       const double inv2 = f.scales.invSigma2[static_cast<std::size_t>(k.octave)];
       if (f.uRight[j] >= 0) {
         const double er = ur - f.uRight[j];

@@ -24,6 +24,7 @@
 
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/util/queue_worker.hpp"
 #include "orbis/util/timing.hpp"
@@ -129,4 +130,5 @@ namespace orbis {
 extern template class LocalMapper<Stereo>;
 extern template class LocalMapper<Rgbd>;
 extern template class LocalMapper<Monocular>;
+extern template class LocalMapper<MonocularFisheye>;
 }  // namespace orbis

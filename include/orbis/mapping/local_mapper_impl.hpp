@@ -262,11 +262,16 @@ Eigen::Matrix3d fundamental(const Camera& camera, const KeyFrame& kf1, const Key
   return fundamentalFromPose(T21.rotationMatrix(), T21.translation(), K, K);
 }
 
-// The triangulated point reprojects within χ² (95%) of keypoint i: 2 dof, 3 with a right coordinate.
+// The triangulated point reprojects within χ² (95%) of keypoint i: 2 dof, 3 with a right coordinate;
+// in the lens's pixels for a camera that observes through one.
 template <CameraModel Camera>
 bool reprojectionOk(const Camera& camera, const KeyFrame& kf, std::size_t i, const Eigen::Vector3d& pc) {
   const Keypoint& k = kf.features().keypointsUn[i];
   const double sigma2 = kf.features().scales.sigma2[static_cast<std::size_t>(k.octave)];
+  if constexpr (ObservesThroughLens<Camera>) {
+    const Eigen::Vector2d error = camera.lens.project(pc) - camera.lensPixel(Eigen::Vector2d(k.u, k.v));
+    return error.squaredNorm() <= 5.991 * sigma2;
+  }
   const Eigen::Vector3d obs = matching::detail::projectWithRight(camera, pc);
   const double ex = obs.x() - k.u, ey = obs.y() - k.v;
   const float uR = kf.features().uRight[i];

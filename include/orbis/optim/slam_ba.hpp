@@ -19,6 +19,7 @@
 
 #include <functional>
 
+#include "orbis/camera/fisheye_plane_camera.hpp"
 #include "orbis/optim/bal.hpp"
 #include "orbis/optim/pose_only_problem.hpp"
 #include "orbis/optim/problem.hpp"
@@ -82,7 +83,7 @@ struct BundleAdjustmentOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   int threads = 1;  // SolverOptions::threads: the same result at any count
   // When set, receives the problem in BAL form before solving (write it with io/bal.hpp's
-  // writeBal for replay with `orbis ba`).
+  // writeBal for replay with `orbis ba`); pinhole and stereo cameras only (BAL has no fisheye).
   std::function<void(const BalProblem&)> inspectBal;
 };
 
@@ -113,6 +114,23 @@ struct MetricResidualFor<RgbdCamera<double>> {
 template <CameraModel Camera>
 using MetricResidual = typename MetricResidualFor<Camera>::type;
 
+// The residual of a camera model's 2-D observations: the pinhole's, or the lens's for a camera
+// that observes through one.
+template <CameraModel Camera>
+struct MonoResidualFor {
+  // The pinhole reprojection.
+  using type = MonoReprojection;
+};
+// Through a lens: the residual in the lens's pixels.
+template <ObservesThroughLens Camera>
+struct MonoResidualFor<Camera> {
+  // The lens's reprojection.
+  using type = Reprojection<typename Camera::Lens>;
+};
+// The residual a camera model's 2-D observations use.
+template <CameraModel Camera>
+using MonoResidual = typename MonoResidualFor<Camera>::type;
+
 // The problem type a camera model needs: a monocular term, plus a 3-D term for metric cameras,
 // each under the robust kernel Kernel.
 template <CameraModel Camera, RobustKernel Kernel>
@@ -125,7 +143,7 @@ template <CameraModel Camera, RobustKernel Kernel>
   requires(Camera::kObservationDim == 2)
 struct SlamProblemFor<Camera, Kernel> {
   // The monocular term only.
-  using type = Problem<SE3Manifold, Term<MonoReprojection, Kernel>>;
+  using type = Problem<SE3Manifold, Term<MonoResidual<Camera>, Kernel>>;
 };
 // The problem type of camera model Camera under kernel Kernel.
 template <CameraModel Camera, RobustKernel Kernel = HuberKernel>
@@ -142,7 +160,7 @@ template <CameraModel Camera, RobustKernel Kernel>
   requires(Camera::kObservationDim == 2)
 struct MotionOnlyProblemFor<Camera, Kernel> {
   // The monocular residual only.
-  using type = PoseOnlyProblem<Kernel, MonoReprojection>;
+  using type = PoseOnlyProblem<Kernel, MonoResidual<Camera>>;
 };
 // The motion-only problem type of camera model Camera under kernel Kernel.
 template <CameraModel Camera, RobustKernel Kernel = HuberKernel>
@@ -195,8 +213,13 @@ ResidualId addObservation(P& problem, const Camera& camera,
       }
     }
   }
-  return problem.add(MonoReprojection{o.measurement.head<2>(), &pinholeOf(camera)}, o.pose, o.point,
-                     o.information, chi2Mono);
+  if constexpr (ObservesThroughLens<Camera>) {
+    return problem.add(MonoResidual<Camera>{camera.lensPixel(o.measurement.head<2>()), &camera.lens}, o.pose, o.point,
+                       o.information, chi2Mono);
+  } else {
+    return problem.add(MonoReprojection{o.measurement.head<2>(), &pinholeOf(camera)}, o.pose, o.point,
+                       o.information, chi2Mono);
+  }
 }
 
 // ORB-SLAM's classification: χ² above the quantile of the observation's dimension, or behind.
@@ -279,7 +302,9 @@ BundleAdjustmentResult bundleAdjustment(const Camera& camera, std::vector<SE3d>&
   for (const auto& o : observations) {
     ids.push_back(slam_detail::addObservation(problem, camera, o, options.chi2Mono, options.chi2Stereo));
   }
-  if (options.inspectBal) options.inspectBal(exportBal(problem));
+  if constexpr (!ObservesThroughLens<Camera>) {  // BAL is a pinhole format: lens problems are not exported
+    if (options.inspectBal) options.inspectBal(exportBal(problem));
+  }
   SolverOptions solver;
   solver.maxIterations = options.iterations;
   solver.abortFlag = options.abortFlag;

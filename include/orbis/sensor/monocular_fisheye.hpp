@@ -1,36 +1,35 @@
 // orbis/sensor/monocular_fisheye.hpp — one fisheye camera: the MonocularFisheye sensor.
 //
-// Contract: MonocularFisheye is a SensorConfiguration for a Kannala-Brandt lens
-// (KannalaBrandtCamera) whose images arrive as the lens took them. ORB runs on the fisheye image
-// and each keypoint's ray — the lens model's exact unprojection — is put on the lens's tangent
-// plane (features/fisheye_features.hpp), the pinhole with the lens's fx, fy, cx, cy (its Camera),
-// where matching windows, epipolar geometry, PnP, triangulation and bundle adjustment work as on
-// any monocular frame: its PipelineSensor is Monocular, so tracking, mapping and loop closing are
-// Monocular's own instantiations. The rays are exact (no image resampling, no approximation of
-// the lens); the noise is not: a keypoint θ off axis has its pixel error stretched by up to
-// 1/cos²θ radially on the plane while bundle adjustment weights it by its pyramid level alone,
-// and rays past maxKeypointAngle (default 70°; the plane ends at 90°) are not used.
-// docs/notes/2026-11-26-fisheye.md measures what that costs and compares it with ORB-SLAM3's
-// residuals through the lens.
+// Contract: MonocularFisheye is a SensorConfiguration for a Kannala–Brandt lens whose images
+// arrive as the lens took them. ORB runs on the fisheye image (Monocular's builder: the same
+// initialisation budget) and each keypoint's ray — the lens model's exact unprojection — is put
+// on the lens's tangent plane (features/fisheye_features.hpp). Its camera, FisheyePlaneCamera,
+// keeps the geometry on that plane (two-view initialisation, epipolar search, triangulation, PnP
+// hypotheses) and everything that weighs pixel noise in the lens's pixels: bundle adjustment's
+// residuals (motion-only, local, full, the initial pair's) and the loop's Sim(3) refinement go
+// through the lens's projection and analytic Jacobian, the χ² gates of fusion and triangulation
+// are taken there, and matching windows are widened by the lens's local stretch. Rays past
+// maxKeypointAngle (default 80°; the plane ends at 90°) are not used. The pipeline is
+// instantiated for this sensor (src/*/ explicit instantiations); the other sensors' code is
+// untouched (if constexpr on ObservesThroughLens). docs/notes/2026-11-26-fisheye.md measures it.
 #pragma once
 
 #include <algorithm>
 #include <numbers>
 
+#include "orbis/camera/fisheye_plane_camera.hpp"
 #include "orbis/camera/kannala_brandt.hpp"
 #include "orbis/features/fisheye_features.hpp"
-#include "orbis/sensor/pipeline_sensor.hpp"
 #include "orbis/sensor/sensor.hpp"
 
 namespace orbis {
 
-// One fisheye camera: the pipeline runs as Monocular on the lens's tangent-plane pinhole, features
-// come through the Kannala–Brandt lens.
+// One fisheye camera: features through the Kannala–Brandt lens onto its tangent plane, residuals
+// and gates in the lens's pixels.
 struct MonocularFisheye {
-  using Camera = PinholeCamera<double>;  // the lens's tangent plane
   // @{
-  // The pipeline's sensor, the lens, the input and ORB-SLAM2's Huber kernel.
-  using PipelineSensor = Monocular;
+  // The lens on its tangent plane, the lens, the input and ORB-SLAM2's Huber kernel.
+  using Camera = FisheyePlaneCamera<double>;
   using Lens = KannalaBrandtCamera<double>;
   using Input = MonocularInput;
   using RobustKernel = optim::HuberKernel;
@@ -43,40 +42,32 @@ struct MonocularFisheye {
   static constexpr int kInitialisationBudgetFactor = Monocular::kInitialisationBudgetFactor;
   // @}
   // Keypoints farther off axis than this (degrees) are dropped.
-  static constexpr double kDefaultMaxKeypointAngleDegrees = 70.0;
+  static constexpr double kDefaultMaxKeypointAngleDegrees = 80.0;
 
-  // The tangent-plane pinhole a lens gives the pipeline.
-  static Camera planeOf(const Lens& lens) { return lens.centralPinhole(); }
+  // The sensor's camera for a lens.
+  static Camera cameraOf(const Lens& lens) { return Camera::ofLens(lens); }
 
-  // ORB on the raw fisheye image, keypoints through the lens.
-  class FeatureBuilder {
-   public:
-    // `camera` is planeOf(lens), the pipeline's camera; the builder works from the lens.
-    FeatureBuilder(const Camera& /*camera*/, const OrbParams& orb, const Lens& lens,
-                   double maxKeypointAngleDegrees = kDefaultMaxKeypointAngleDegrees)
-        : lens_(lens),
-          maxAngle_(std::min(maxKeypointAngleDegrees, 89.0) * std::numbers::pi / 180.0),
-          trackingExtractor_(orb),
-          initialisationExtractor_(initialisationParams(orb)) {}
-    // The frame's features.
-    FrameFeatures build(const Input& in) {
-      return extractFisheye(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, lens_, maxAngle_);
-    }
+  // Keypoints through the lens onto its tangent plane, within maxAngle (radians) of the axis.
+  struct KeypointsOnPlane {
     // @{
-    // Whether the builder uses the initialisation budget.
-    void setInitialising(bool initialising) { isInitialising_ = initialising; }
-    bool initialising() const { return isInitialising_; }
+    // The lens and the widest angle kept.
+    Lens lens;
+    double maxAngle = 0;
     // @}
-
-   private:
-    static OrbParams initialisationParams(OrbParams orb) {
-      orb.features *= kInitialisationBudgetFactor;
-      return orb;
+    // The image's features.
+    FrameFeatures operator()(OrbExtractor& extractor, const cv::Mat& image) const {
+      return extractFisheye(extractor, image, lens, maxAngle);
     }
-    Lens lens_;
-    double maxAngle_;
-    OrbExtractor trackingExtractor_, initialisationExtractor_;
-    bool isInitialising_ = true;
+  };
+
+  // ORB on the raw fisheye image, keypoints through the lens; twice the budget while initialising.
+  class FeatureBuilder : public MonocularFeatureBuilder<KeypointsOnPlane> {
+   public:
+    // Keypoints up to maxKeypointAngleDegrees off axis (at most 89: the plane ends at 90).
+    FeatureBuilder(const Camera& camera, const OrbParams& orb,
+                   double maxKeypointAngleDegrees = kDefaultMaxKeypointAngleDegrees)
+        : MonocularFeatureBuilder<KeypointsOnPlane>(
+              {camera.lens, std::min(maxKeypointAngleDegrees, 89.0) * std::numbers::pi / 180.0}, orb) {}
   };
 };
 

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <concepts>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -139,6 +140,42 @@ struct Rgbd {
   };
 };
 
+// The builder every monocular sensor shares (paper Fig. 2b for one image): ORB on the image with
+// the tracking budget, or with kInitialisationBudget times it while initialising() (see
+// Monocular), each extractor's pyramid levels on both cores; KeypointsOf turns an extractor's
+// keypoints into the frame's features (a callable (OrbExtractor&, const cv::Mat&) ->
+// FrameFeatures: undistorted with a RadTan lens, or put on a fisheye's tangent plane).
+template <class KeypointsOf>
+class MonocularFeatureBuilder {
+ public:
+  // The initialisation budget: times the features while initialising (ORB-SLAM2's).
+  static constexpr int kInitialisationBudget = 2;
+
+  // Extractors for orb's budget and the initialisation budget.
+  MonocularFeatureBuilder(KeypointsOf keypointsOf, const OrbParams& orb)
+      : keypointsOf_(std::move(keypointsOf)), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {
+    trackingExtractor_.setParallelLevels(true);  // one image per frame: its levels use both cores
+    initialisationExtractor_.setParallelLevels(true);
+  }
+  // The frame's features.
+  FrameFeatures build(const MonocularInput& in) {
+    return keypointsOf_(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image);
+  }
+  // Switches the initialisation budget on or off (the tracker's owner does).
+  void setInitialising(bool initialising) { isInitialising_ = initialising; }
+  // Whether the builder uses the initialisation budget.
+  bool initialising() const { return isInitialising_; }
+
+ private:
+  static OrbParams initialisationParams(OrbParams orb) {
+    orb.features *= kInitialisationBudget;
+    return orb;
+  }
+  KeypointsOf keypointsOf_;
+  OrbExtractor trackingExtractor_, initialisationExtractor_;
+  bool isInitialising_ = true;
+};
+
 // One camera, no depth: the map's scale is arbitrary (kMetricScale false), so the pipeline
 // initialises from two views (geometry/two_view.hpp) rather than one frame, and loops are
 // Sim(3). Keypoints are undistorted with the lens model (RadTan, zero = already undistorted).
@@ -163,38 +200,29 @@ struct Monocular {
   static constexpr bool kMetricScale = false;
   static constexpr bool kDepthFromSensor = false;
   // @}
-  // The initialisation budget: times the features while initialising.
-  static constexpr int kInitialisationBudgetFactor = 2;
+
+  // Keypoints undistorted with a radial-tangential lens onto the camera's pinhole.
+  struct UndistortedKeypoints {
+    // @{
+    // The pinhole and the images' distortion.
+    Camera camera;
+    RadTanDistortion<double> lens;
+    // @}
+    // The image's features.
+    FrameFeatures operator()(OrbExtractor& extractor, const cv::Mat& image) const {
+      return extractMonocular(extractor, image, camera, lens);
+    }
+  };
 
   // ORB on the image, keypoints undistorted with the lens; twice the budget while initialising.
-  class FeatureBuilder {
+  class FeatureBuilder : public MonocularFeatureBuilder<UndistortedKeypoints> {
    public:
     // lens: the images' distortion (zero when they are undistorted).
     FeatureBuilder(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens = {})
-        : camera_(camera), lens_(lens), trackingExtractor_(orb), initialisationExtractor_(initialisationParams(orb)) {
-      trackingExtractor_.setParallelLevels(true);  // one image per frame: its levels use both cores
-      initialisationExtractor_.setParallelLevels(true);
-    }
-    // The frame's features.
-    FrameFeatures build(const Input& in) {
-      return extractMonocular(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image, camera_, lens_);
-    }
-    // @{
-    // Whether the builder uses the initialisation budget (set by the tracker's owner).
-    void setInitialising(bool initialising) { isInitialising_ = initialising; }
-    bool initialising() const { return isInitialising_; }
-    // @}
-
-   private:
-    static OrbParams initialisationParams(OrbParams orb) {
-      orb.features *= kInitialisationBudgetFactor;
-      return orb;
-    }
-    Camera camera_;
-    RadTanDistortion<double> lens_;
-    OrbExtractor trackingExtractor_, initialisationExtractor_;
-    bool isInitialising_ = true;
+        : MonocularFeatureBuilder<UndistortedKeypoints>({camera, lens}, orb) {}
   };
+  // The initialisation budget: times the features while initialising.
+  static constexpr int kInitialisationBudgetFactor = FeatureBuilder::kInitialisationBudget;
 };
 
 static_assert(SensorConfiguration<Monocular>);

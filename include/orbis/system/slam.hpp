@@ -1,9 +1,8 @@
 // orbis/system/slam.hpp — the SLAM system a user instantiates: orbis::Slam<Sensor>.
 //
 // Contract: Slam<Sensor> turns each input into features with the sensor's compile-time
-// FeatureBuilder, then hands them to SlamCore<PipelineSensor<Sensor>> (tracking, local mapping,
-// loop closing over one Map, every stage templated on the same sensor: Sensor itself, or the one
-// it names as its PipelineSensor, as MonocularFisheye names Monocular). track() returns the frame's pose and
+// FeatureBuilder, then hands them to SlamCore<Sensor> (tracking, local mapping, loop closing over
+// one Map, every stage templated on the same sensor). track() returns the frame's pose and
 // tracking state. Two modes: threaded (real time: local mapping and loop closing run on their
 // own threads) and
 // deterministic (the same stages run inline in a fixed order after each frame, so the same
@@ -16,7 +15,6 @@
 #include <memory>
 #include <vector>
 
-#include "orbis/sensor/pipeline_sensor.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/system/slam_core.hpp"
 #include "orbis/util/timing.hpp"
@@ -38,8 +36,8 @@ class Slam {
   Slam(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
        SlamOptions options = {})
       : builder_(camera, orb), core_(camera, std::move(vocabulary), options) {}
-  // A monocular camera whose images still carry lens distortion (the builder undistorts keypoints):
-  // RadTanDistortion for Monocular, the KannalaBrandtCamera for MonocularFisheye.
+  // A monocular camera whose images still carry radial-tangential distortion (the builder
+  // undistorts keypoints; a fisheye's lens is part of MonocularFisheye's camera).
   template <class Lens>
   Slam(const Camera& camera, const OrbParams& orb, const Lens& lens, std::shared_ptr<const OrbVocabulary> vocabulary,
        SlamOptions options = {})
@@ -86,8 +84,8 @@ class Slam {
   // Per-stage timing.
   const StageTimer& timer() const { return core_.timer(); }
   // @{
-  // The core, for what Slam does not forward (map files, the map itself): its pipeline sensor's.
-  using Core = SlamCore<PipelineSensor<Sensor>>;
+  // The core, for what Slam does not forward (map files, the map itself).
+  using Core = SlamCore<Sensor>;
   Core& core() { return core_; }
   const Core& core() const { return core_; }
   // @}
@@ -100,7 +98,7 @@ class Slam {
   }
 
   typename Sensor::FeatureBuilder builder_;
-  SlamCore<PipelineSensor<Sensor>> core_;
+  SlamCore<Sensor> core_;
 };
 
 }  // namespace orbis

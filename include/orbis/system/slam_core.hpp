@@ -24,6 +24,7 @@
 #include "orbis/loop/loop_closer.hpp"
 #include "orbis/map/map.hpp"
 #include "orbis/mapping/local_mapper.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/viewer/slam_observer.hpp"
 #include "orbis/tracking/relocaliser.hpp"
@@ -212,5 +213,6 @@ namespace orbis {
 extern template class SlamCore<Stereo>;
 extern template class SlamCore<Rgbd>;
 extern template class SlamCore<Monocular>;
+extern template class SlamCore<MonocularFisheye>;
 
 }  // namespace orbis

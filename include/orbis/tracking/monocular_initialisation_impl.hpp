@@ -122,7 +122,7 @@ bool Tracker<Sensor>::initialiseFromTwoViews(FrameT& f)
                        f.features->scales.sigma2[std::size_t(k2.octave)]});
     pairs.emplace_back(i1, i2);
   }
-  const TwoViewResult twoView = initialiseTwoView(matches, f.camera->K(), initialisationRng_);
+  const TwoViewResult twoView = initialiseTwoView(matches, pinholeOf(*f.camera).K(), initialisationRng_);
   initialisationRefusal_ = twoView.refusal;
   note("initialisation_inliers", twoView.inliers);
   note("initialisation_good", twoView.goodPoints);

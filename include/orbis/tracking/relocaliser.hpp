@@ -32,6 +32,7 @@
 #include "orbis/map/map.hpp"
 #include "orbis/camera/pinhole.hpp"
 #include "orbis/map/frame.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/sensor/sensor.hpp"
 
 namespace orbis {
@@ -135,4 +136,5 @@ namespace orbis {
 extern template class Relocaliser<Stereo>;
 extern template class Relocaliser<Rgbd>;
 extern template class Relocaliser<Monocular>;
+extern template class Relocaliser<MonocularFisheye>;
 }  // namespace orbis

@@ -34,6 +34,7 @@
 #include "orbis/map/local_mapping_control.hpp"
 #include "orbis/map/map.hpp"
 #include "orbis/map/slam_events.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/util/timing.hpp"
 
@@ -231,4 +232,5 @@ namespace orbis {
 extern template class Tracker<Stereo>;
 extern template class Tracker<Rgbd>;
 extern template class Tracker<Monocular>;
+extern template class Tracker<MonocularFisheye>;
 }  // namespace orbis
