@@ -23,7 +23,7 @@ row() {
   rm -f out.yaml
   local said rc
   said=$(timeout 600 "$@" 2>&1 >/dev/null); rc=$?
-  said=$(echo "$said" | grep -vE "^calibrate: detecting|\[=*|^\s*$" | head -2 | sed -e 's/|/\\|/g' -e "s#$W/##g" -e "s#$D/##g" \
+  said=$(echo "$said" | grep -vE "^calibrate: |^\s*$" | head -2 | sed -e 's/|/\\|/g' -e "s#$W/##g" -e "s#$D/##g" \
          | tr '\n' ' ' | cut -c1-600)
   [[ -z $said ]] && said="(nothing: calibrated)"
   local wrote="nothing written"
@@ -32,12 +32,12 @@ row() {
 }
 
 # --- fixtures -------------------------------------------------------------------------------
-synth() { [[ -d $1 ]] || "$B" synth "$1" --pattern "$P" --width 320 --height 240 --fx 260 --views "$2" --noise 1 --seed "${3:-3}" "${@:4}" >/dev/null; }
+synth() { [[ -d $1 ]] || "$B" synth "$1" --pattern "$P" --width 480 --height 360 --fx 380 --views "$2" --noise 1 --seed "${3:-3}" "${@:4}" >/dev/null; }
 synth good 10
 synth few 3
 synth flat 10 6 --square-on
 synth rig 10 4 --rig --baseline 0.08
-synth small 10 5 --width 256 --height 192 --fx 210 --rig --baseline 0.08
+synth small 10 5 --width 400 --height 300 --fx 320 --rig --baseline 0.08
 rm -rf blurred && mkdir -p blurred
 for f in good/images/*.png; do ffmpeg -loglevel error -y -i "$f" -vf gblur=sigma=3 "blurred/$(basename "$f")"; done
 rm -rf nopattern && mkdir -p nopattern && for f in $(ls "$D"/tum_fr3_teddy_200/rgb/*.png | head -8); do ln -sf "$f" nopattern/; done
@@ -60,7 +60,7 @@ row "a folder without images" "$B" calibrate images empty --pattern "$P" --out o
 row "an unreadable image only" "$B" calibrate images unreadable --pattern "$P" --out out.yaml
 row "one unreadable image among 10 (the rest calibrate)" "$B" calibrate images mixed --pattern "$P" --out out.yaml
 row "stereo: 10 left views, 9 right" "$B" calibrate images rig_short/left --right rig_short/right --pattern "$P" --out out.yaml
-row "stereo: left 320x240, right 256x192" "$B" calibrate images rig/left --right small/right --pattern "$P" --out out.yaml
+row "stereo: left 480x360, right 400x300" "$B" calibrate images rig/left --right small/right --pattern "$P" --out out.yaml
 row "stereo: left and right swapped" "$B" calibrate images rig/right --right rig/left --pattern "$P" --out out.yaml
 row "stereo: --right and --stereo together" "$B" calibrate images rig/left --right rig/right --stereo side-by-side --pattern "$P" --out out.yaml
 row "wrong --pattern syntax (chessboard:9x6)" "$B" calibrate images good/images --pattern chessboard:9x6 --out out.yaml

@@ -28,6 +28,7 @@ from . import _orbis
 from ._orbis import (
     Error,
     MissingFileError,
+    MonocularFisheyeSlam,
     MonocularSlam,
     OrbParams,
     RgbdSlam,
@@ -43,11 +44,26 @@ from ._orbis import (
 )
 from . import ba, datasets, eval, sources  # noqa: E402  (the submodules import the names above)
 
+_pinhole_monocular_new = MonocularSlam.__new__
+
+
+def _monocular_slam_new(cls, *args, **kwargs):
+    """MonocularSlam(settings) of a fisheye (Camera.type: KannalaBrandt8) is a MonocularFisheyeSlam:
+    the settings pick the lens model, as `orbis run --settings` does."""
+    settings = args[0] if args else kwargs.get("settings")
+    if cls is MonocularSlam and isinstance(settings, Settings) and settings.camera.get("model") == "kannala_brandt":
+        return MonocularFisheyeSlam(*args, **kwargs)
+    return _pinhole_monocular_new(cls, *args, **kwargs)
+
+
+MonocularSlam.__new__ = _monocular_slam_new
+
 __version__: str = _orbis.__version__
 
 __all__ = [
     "Error",
     "MissingFileError",
+    "MonocularFisheyeSlam",
     "MonocularSlam",
     "OrbParams",
     "RgbdSlam",

@@ -214,7 +214,7 @@ void bindPairTrack(py::class_<SlamSession<Sensor>>& c) {
        "track",
        [](SlamSession<Sensor>& s, const py::handle& first, const py::handle& second, double timestamp) {
          const ImageView firstView = imageView(first, Args::kFirst), secondView = Args::kSecondView(second, Args::kSecond);
-         return s.track(Input{timestamp, firstView.mat, secondView.mat});
+         return s.track(s.raw(Input{timestamp, firstView.mat, secondView.mat}));
        },
        py::arg(Args::kFirst), py::arg(Args::kSecond), "timestamp"_a,
        "Tracks one frame; returns (TrackingState, 4 x 4 float64 camera-to-world pose, or None when\n"
@@ -234,7 +234,7 @@ void bindPairTrack(py::class_<SlamSession<Sensor>>& c) {
             const cv::Mat& second = Sensor::kKind == SensorKind::Stereo ? frame.right : frame.depth;
             if (frame.image.empty() || second.empty())
               throw py::value_error("frame " + std::to_string(frame.index) + " has no " + Args::kSecond + " image");
-            return s.track(Input{frame.timestamp, frame.image, second});
+            return s.track(s.raw(Input{frame.timestamp, frame.image, second}));
           },
           "frame"_a, "Tracks a frame of orbis.sources (its images and timestamp).");
 }
@@ -257,22 +257,67 @@ std::shared_ptr<const OrbVocabulary> vocabularyOrDefault(std::shared_ptr<OrbVoca
   return defaultVocabulary();
 }
 
+// A session of a pinhole sensor (Monocular, Stereo, Rgbd) from settings.
+template <class Sensor>
+std::unique_ptr<SlamSession<Sensor>> makePinholeSession(const Settings& settings, std::shared_ptr<OrbVocabulary> vocabulary,
+                                                        const SlamOptions& options, std::optional<double> fps);
+
 template <class Sensor>
 std::unique_ptr<SlamSession<Sensor>> makeSession(const Settings& settings, std::shared_ptr<OrbVocabulary> vocabulary,
                                                   const SlamOptions& options, std::optional<double> fps) {
+  if constexpr (std::is_same_v<Sensor, MonocularFisheye>) {
+    const auto* lens = std::get_if<KannalaBrandtCamera<double>>(&settings.camera);
+    if (!lens)
+      throw py::value_error("the settings describe no fisheye (Camera.type: KannalaBrandt8); use MonocularSlam");
+    SlamOptions o = options;
+    o.fps = fps.value_or(settings.fps);
+    return std::make_unique<SlamSession<Sensor>>(MonocularFisheye::cameraOf(*lens), settings.orb,
+                                                 vocabularyOrDefault(std::move(vocabulary)), o, *lens);
+  } else {
+    return makePinholeSession<Sensor>(settings, std::move(vocabulary), options, fps);
+  }
+}
+
+template <class Sensor>
+std::unique_ptr<SlamSession<Sensor>> makePinholeSession(const Settings& settings, std::shared_ptr<OrbVocabulary> vocabulary,
+                                                        const SlamOptions& options, std::optional<double> fps) {
+  if constexpr (Sensor::kKind == SensorKind::Monocular) {
+    if (std::holds_alternative<KannalaBrandtCamera<double>>(settings.camera))
+      throw py::value_error("the settings describe a fisheye (Camera.type: KannalaBrandt8): orbis.MonocularSlam runs it "
+                            "as orbis.MonocularFisheyeSlam");
+  }
   const auto* camera = std::get_if<typename Sensor::Camera>(&settings.camera);
   if (!camera)
     throw py::value_error("the settings describe a " + std::string(toString(settings.sensor)) + " camera; this class needs " +
                           std::string(toString(Sensor::kKind)) + " (Settings.load(path, sensor=...))");
   SlamOptions o = options;
   o.fps = fps.value_or(settings.fps);
-  return std::make_unique<SlamSession<Sensor>>(*camera, settings.orb, vocabularyOrDefault(std::move(vocabulary)), o,
-                                               settings.distortion);
+  auto session = std::make_unique<SlamSession<Sensor>>(*camera, settings.orb, vocabularyOrDefault(std::move(vocabulary)),
+                                                       o, settings.distortion);
+  if constexpr (Sensor::kKind == SensorKind::Stereo)
+    if (settings.rectification) session->setRectification(settings.stereoRectification());
+  return session;
 }
+
+// A session of a pinhole sensor from a dataset's own calibration.
+template <class Sensor>
+std::unique_ptr<SlamSession<Sensor>> makeDatasetSession(const DatasetReader& dataset, std::shared_ptr<OrbVocabulary> vocabulary,
+                                                        const SlamOptions& options, std::optional<double> fps);
 
 template <class Sensor>
 std::unique_ptr<SlamSession<Sensor>> makeSession(const DatasetReader& dataset, std::shared_ptr<OrbVocabulary> vocabulary,
                                                  const SlamOptions& options, std::optional<double> fps) {
+  if constexpr (std::is_same_v<Sensor, MonocularFisheye>) {
+    throw py::value_error("a dataset is read through a pinhole (a fisheye EuRoC is undistorted on load): use "
+                          "MonocularSlam, or Settings with Camera.type: KannalaBrandt8");
+  } else {
+    return makeDatasetSession<Sensor>(dataset, std::move(vocabulary), options, fps);
+  }
+}
+
+template <class Sensor>
+std::unique_ptr<SlamSession<Sensor>> makeDatasetSession(const DatasetReader& dataset, std::shared_ptr<OrbVocabulary> vocabulary,
+                                                        const SlamOptions& options, std::optional<double> fps) {
   const DatasetCamera camera = dataset.camera();
   const auto* typed = std::get_if<typename Sensor::Camera>(&camera);
   if (!typed)
@@ -335,10 +380,18 @@ void bindSlam(py::module_& m) {
       .value("LOST", TrackingState::Lost);
   bindSlamClass<Stereo>(m, "StereoSlam",
                         "ORB-SLAM2 on a rectified stereo camera (orbis::Slam<orbis::Stereo>).\n"
-                        "track(left, right, timestamp) or track(frame).");
+                        "track(left, right, timestamp) or track(frame). Built from Settings with LEFT./RIGHT.\n"
+                        "rectification blocks (ORB-SLAM2's EuRoC.yaml, `orbis calibrate --right`, fisheye pairs\n"
+                        "included), raw pairs and sources' frames are rectified on load; a dataset's Frame comes\n"
+                        "rectified by its reader and is tracked as it is.");
   bindSlamClass<Rgbd>(m, "RgbdSlam",
                       "ORB-SLAM2 on an RGB-D camera (orbis::Slam<orbis::Rgbd>).\n"
                       "track(image, depth, timestamp) or track(frame).");
+  bindSlamClass<MonocularFisheye>(m, "MonocularFisheyeSlam",
+                                  "ORB-SLAM2 on one Kannala-Brandt fisheye camera, on the fisheye images directly\n"
+                                  "(orbis::Slam<orbis::MonocularFisheye>, docs/guide/fisheye.md): built from Settings\n"
+                                  "with Camera.type: KannalaBrandt8 (orbis.MonocularSlam(settings) gives one for such\n"
+                                  "settings). track(image, timestamp) or track(frame).");
   bindSlamClass<Monocular>(m, "MonocularSlam",
                            "ORB-SLAM2 on one camera (orbis::Slam<orbis::Monocular>): the map's scale is arbitrary.\n"
                            "track(image, timestamp) or track(frame). Lens distortion (Camera.k1..k3) is undistorted\n"

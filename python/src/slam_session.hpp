@@ -7,6 +7,7 @@
 // ValueError (size, timestamp); tracking after shutdown() raises orbis.Error.
 #pragma once
 
+#include <concepts>
 #include <pybind11/pybind11.h>
 
 #include <array>
@@ -15,10 +16,13 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "arrays.hpp"
+#include "orbis/camera/rectification.hpp"
+#include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/system/slam.hpp"
 #include "orbis/util/error.hpp"
 
@@ -30,14 +34,27 @@ inline std::vector<const cv::Mat*> inputImages(const StereoInput& in) { return {
 inline std::vector<const cv::Mat*> inputImages(const RgbdInput& in) { return {&in.image, &in.depth}; }
 inline std::vector<const cv::Mat*> inputImages(const MonocularInput& in) { return {&in.image}; }
 
+// What a sensor's images still carry: radial-tangential distortion (Monocular; zero for the
+// rectified stereo and RGB-D images), or the Kannala-Brandt lens of MonocularFisheye.
+template <class Sensor>
+struct SessionLens {
+  using type = RadTanDistortion<double>;
+};
+template <>
+struct SessionLens<MonocularFisheye> {
+  using type = KannalaBrandtCamera<double>;
+};
+
 template <class Sensor>
 class SlamSession {
  public:
   using Camera = typename Sensor::Camera;
+  using Lens = typename SessionLens<Sensor>::type;
 
-  // lens: the distortion still in a monocular camera's images (stereo and RGB-D images arrive rectified).
+  // lens: the distortion still in a monocular camera's images (stereo and RGB-D images arrive
+  // rectified), or the fisheye lens of MonocularFisheye.
   SlamSession(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
-              const SlamOptions& options, const RadTanDistortion<double>& lens = {})
+              const SlamOptions& options, const Lens& lens = {})
       : camera_(camera), localisationOnly_(options.localisationOnly), slam_(makeSlam(camera, orb, lens, std::move(vocabulary), options)) {}
 
   ~SlamSession() {
@@ -92,10 +109,30 @@ class SlamSession {
   }
   const Camera& camera() const { return camera_; }
 
+  // Stereo from settings with LEFT./RIGHT. blocks: raw pairs are rectified on load, as `orbis run`
+  // does for frames without a calibration of their own.
+  void setRectification(StereoRectification rectification) { rectification_ = std::move(rectification); }
+  // A raw input as the pipeline takes it: a stereo pair rectified when the settings say how.
+  typename Sensor::Input raw(const typename Sensor::Input& input) const {
+    if constexpr (Sensor::kKind == SensorKind::Stereo) {
+      if (rectification_ && !input.left.empty() && !input.right.empty()) {
+        const RectificationBlock& block = rectification_->left;
+        if (input.left.cols != block.width || input.left.rows != block.height)
+          throw py::value_error("image of " + std::to_string(input.left.cols) + " x " + std::to_string(input.left.rows) +
+                                " pixels; the settings rectify " + std::to_string(block.width) + " x " +
+                                std::to_string(block.height));
+        StereoRectification::Images rectified = rectification_->rectify(input.left, input.right);
+        return {input.timestamp, rectified.left, rectified.right};
+      }
+    }
+    return input;
+  }
+
  private:
-  static std::unique_ptr<Slam<Sensor>> makeSlam(const Camera& camera, const OrbParams& orb, const RadTanDistortion<double>& lens,
+  static std::unique_ptr<Slam<Sensor>> makeSlam(const Camera& camera, const OrbParams& orb, const Lens& lens,
                                                 std::shared_ptr<const OrbVocabulary> vocabulary, const SlamOptions& options) {
-    if constexpr (Sensor::kKind == SensorKind::Monocular)
+    // A pinhole monocular camera's builder undistorts with the lens; a fisheye camera carries its own.
+    if constexpr (std::constructible_from<typename Sensor::FeatureBuilder, const Camera&, const OrbParams&, const Lens&>)
       return std::make_unique<Slam<Sensor>>(camera, orb, lens, std::move(vocabulary), options);
     else return std::make_unique<Slam<Sensor>>(camera, orb, std::move(vocabulary), options);
   }
@@ -113,6 +150,7 @@ class SlamSession {
   }
 
   Camera camera_;
+  std::optional<StereoRectification> rectification_;
   bool localisationOnly_;
   std::unique_ptr<Slam<Sensor>> slam_;
   std::mutex mutex_;

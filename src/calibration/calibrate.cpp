@@ -335,13 +335,7 @@ Fit fitModel(LensModel model, const std::vector<std::vector<cv::Point3f>>& objec
 // off exactly and the set is degenerate (Zhang's method needs foreshortened boards).
 double depthSpread(const CalibratedCamera& camera, const std::vector<cv::Point3f>& object,
                    const std::vector<cv::Point2f>& image) {
-  const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-  std::vector<cv::Point2f> normalised;
-  if (camera.model == LensModel::Fisheye)
-    cv::fisheye::undistortPoints(image, normalised, K, cv::Vec4d(camera.distortion[0], camera.distortion[1],
-                                                                 camera.distortion[2], camera.distortion[3]));
-  else
-    cv::undistortPoints(image, normalised, K, camera.distortion);
+  const std::vector<cv::Point2f> normalised = undistortToPlane(camera, image);
   std::vector<cv::Point2f> plane;
   for (const cv::Point3f& p : object) plane.emplace_back(p.x, p.y);
   const cv::Mat H = cv::findHomography(plane, normalised);
@@ -355,7 +349,9 @@ double depthSpread(const CalibratedCamera& camera, const std::vector<cv::Point3f
   return std::abs(mean) > 0 ? (highest - lowest) / std::abs(mean) : 0;
 }
 
-SE3d poseOf(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
+}  // namespace
+
+SE3d poseFromRotationVector(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
   cv::Matx33d R;
   cv::Rodrigues(rvec, R);
   Eigen::Matrix3d r;
@@ -364,7 +360,16 @@ SE3d poseOf(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
   return SE3d(r, Eigen::Vector3d(tvec[0], tvec[1], tvec[2]));
 }
 
-}  // namespace
+std::vector<cv::Point2f> undistortToPlane(const CalibratedCamera& camera, const std::vector<cv::Point2f>& pixels) {
+  const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  std::vector<cv::Point2f> normalised;
+  if (camera.model == LensModel::Fisheye)
+    cv::fisheye::undistortPoints(pixels, normalised, K, cv::Vec4d(camera.distortion[0], camera.distortion[1],
+                                                                  camera.distortion[2], camera.distortion[3]));
+  else
+    cv::undistortPoints(pixels, normalised, K, camera.distortion);
+  return normalised;
+}
 
 CalibrationResult calibrate(const std::vector<CalibrationView>& views, const CalibrationPattern& pattern,
                             const CalibrationOptions& options, const std::string& source) {
@@ -507,8 +512,8 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, const Cal
   double widestTurn = 0;
   for (std::size_t a = 0; a < fit.rvecs.size(); ++a)
     for (std::size_t b = a + 1; b < fit.rvecs.size(); ++b) {
-      const Eigen::Vector3d na = poseOf(fit.rvecs[a], fit.tvecs[a]).rotationMatrix().col(2);
-      const Eigen::Vector3d nb = poseOf(fit.rvecs[b], fit.tvecs[b]).rotationMatrix().col(2);
+      const Eigen::Vector3d na = poseFromRotationVector(fit.rvecs[a], fit.tvecs[a]).rotationMatrix().col(2);
+      const Eigen::Vector3d nb = poseFromRotationVector(fit.rvecs[b], fit.tvecs[b]).rotationMatrix().col(2);
       widestTurn = std::max(widestTurn, std::acos(std::clamp(na.dot(nb), -1.0, 1.0)));
     }
   if (widestTurn < options.minTiltDegrees * M_PI / 180.0) {
@@ -548,7 +553,7 @@ CalibrationResult calibrate(const std::vector<CalibrationView>& views, const Cal
     ViewOutcome& o = result.views[selected[k]];
     o.used = true;
     o.rms = fit.viewRms[k];
-    result.cameraFromBoard.push_back(poseOf(fit.rvecs[k], fit.tvecs[k]));
+    result.cameraFromBoard.push_back(poseFromRotationVector(fit.rvecs[k], fit.tvecs[k]));
     result.usedNames.push_back(views[selected[k]].name);
     result.usedCorners.push_back(views[selected[k]].detection->corners);
   }

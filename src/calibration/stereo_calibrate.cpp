@@ -53,20 +53,9 @@ cv::Matx33d cameraMatrix(const CalibratedCamera& c) { return {c.fx, 0, c.cx, 0, 
 
 // A camera's pose of the board from its corners alone (PnP on undistorted rays).
 SE3d boardPose(const CalibratedCamera& camera, const std::vector<cv::Point3f>& board, const std::vector<cv::Point2f>& image) {
-  std::vector<cv::Point2f> normalised;
-  if (camera.model == LensModel::Fisheye)
-    cv::fisheye::undistortPoints(image, normalised, cameraMatrix(camera),
-                                 cv::Vec4d(camera.distortion[0], camera.distortion[1], camera.distortion[2], camera.distortion[3]));
-  else
-    cv::undistortPoints(image, normalised, cameraMatrix(camera), camera.distortion);
   cv::Vec3d rvec, tvec;
-  cv::solvePnP(board, normalised, cv::Matx33d::eye(), cv::noArray(), rvec, tvec);
-  cv::Matx33d R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d r;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) r(i, j) = R(i, j);
-  return SE3d(r, Eigen::Vector3d(tvec[0], tvec[1], tvec[2]));
+  cv::solvePnP(board, undistortToPlane(camera, image), cv::Matx33d::eye(), cv::noArray(), rvec, tvec);
+  return poseFromRotationVector(rvec, tvec);
 }
 
 // The rig moved by δ: rotation R·exp(δω), translation t + δt (so δt is t's own perturbation).
@@ -186,6 +175,14 @@ SE3d fitRig(const Lens& l, const Lens& r, const std::vector<CommonCorners>& corn
   return rig;
 }
 
+// The sum of squared reprojection errors of the pairs under a rig, each board pose refined.
+double rigError(const Lens& l, const Lens& r, const SE3d& rig, const std::vector<CommonCorners>& corners) {
+  double squared = 0;
+  for (const CommonCorners& c : corners)
+    squared += pairResiduals(l, r, rig, refinePose(l, r, rig, boardPose(l.camera, c.board, c.left), c), c).squaredNorm();
+  return squared;
+}
+
 // The pose of view `name` in a camera's calibration, or PnP when the calibration did not fit it.
 SE3d viewPose(const CalibrationResult& r, const std::string& name, const CalibratedCamera& camera,
               const std::vector<cv::Point3f>& board, const std::vector<cv::Point2f>& image) {
@@ -263,9 +260,34 @@ StereoCalibrationResult calibrateStereo(const std::vector<CalibrationView>& left
                                 " are needed for the extrinsics: take more pairs with the whole board in view of both "
                                 "cameras, tilted by 20-45 degrees in several directions");
 
-  // Extrinsics with the intrinsics fixed: OpenCV for pinholes, fitRig for fisheyes (see there).
-  const cv::Size size(lc.width, lc.height);
-  if (options.model == LensModel::Pinhole) {
+  // Extrinsics with the intrinsics fixed: orbis's fitRig (see there), and for pinholes also
+  // OpenCV's stereoCalibrate, kept when it explains the corners at least as well (on 8 small
+  // rendered pairs it converged to a rig 5x too short, 15 px RMS: docs/notes/2026-11-26-fisheye.md).
+  const Lens leftLens(lc), rightLens(rc);
+  std::vector<SE3d> leftPoses, rightPoses;
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    leftPoses.push_back(viewPose(result.left, left[used[k]].name, lc, corners[k].board, corners[k].left));
+    rightPoses.push_back(viewPose(result.right, right[used[k]].name, rc, corners[k].board, corners[k].right));
+  }
+  std::vector<bool> consistent;
+  result.rightFromLeft = fitRig(leftLens, rightLens, corners, leftPoses, rightPoses, consistent);
+  std::vector<CommonCorners> kept;
+  std::vector<std::size_t> keptPairs;
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    if (consistent[k]) {
+      kept.push_back(std::move(corners[k]));
+      keptPairs.push_back(used[k]);
+    } else {
+      result.pairs[used[k]].rejected = "the two views disagree on the rig (not taken at the same moment?)";
+    }
+  }
+  corners = std::move(kept);
+  used = std::move(keptPairs);
+  if (used.size() < 3)
+    throw Error(source, "", "only " + std::to_string(used.size()) + " pairs agree on where the right camera is: check "
+                                "that --right names the right camera's views of the same moments, in the same order");
+  if (options.model == LensModel::Pinhole && static_cast<int>(used.size()) >= options.minViews) {
+    const cv::Size size(lc.width, lc.height);
     std::vector<std::vector<cv::Point3f>> object;
     std::vector<std::vector<cv::Point2f>> l, r;
     for (const CommonCorners& c : corners) object.push_back(c.board), l.push_back(c.left), r.push_back(c.right);
@@ -273,36 +295,16 @@ StereoCalibrationResult calibrateStereo(const std::vector<CalibrationView>& left
     const cv::TermCriteria criteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, DBL_EPSILON);
     try {
       cv::stereoCalibrate(object, l, r, K1, D1, K2, D2, size, R, T, E, F, cv::CALIB_FIX_INTRINSIC, criteria);
-    } catch (const cv::Exception& e) {
-      throw Error(source, "", std::string("the stereo calibration did not converge (OpenCV: ") + e.err +
-                                  "): check that --right names the right camera's views of the same moments, in "
-                                  "the same order");
+      Eigen::Matrix3d rotation;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) rotation(i, j) = R.at<double>(i, j);
+      const SE3d opencv(Eigen::Quaterniond(rotation).normalized().toRotationMatrix(),
+                        Eigen::Vector3d(T.at<double>(0), T.at<double>(1), T.at<double>(2)));
+      if (rigError(leftLens, rightLens, opencv, corners) <= rigError(leftLens, rightLens, result.rightFromLeft, corners))
+        result.rightFromLeft = opencv;
+    } catch (const cv::Exception&) {
+      // orbis's fit stands.
     }
-    Eigen::Matrix3d rotation;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) rotation(i, j) = R.at<double>(i, j);
-    result.rightFromLeft = SE3d(Eigen::Quaterniond(rotation).normalized().toRotationMatrix(),
-                                Eigen::Vector3d(T.at<double>(0), T.at<double>(1), T.at<double>(2)));
-  } else {
-    std::vector<SE3d> leftPoses, rightPoses;
-    for (std::size_t k = 0; k < used.size(); ++k) {
-      leftPoses.push_back(viewPose(result.left, left[used[k]].name, lc, corners[k].board, corners[k].left));
-      rightPoses.push_back(viewPose(result.right, right[used[k]].name, rc, corners[k].board, corners[k].right));
-    }
-    std::vector<bool> consistent;
-    result.rightFromLeft = fitRig(Lens(lc), Lens(rc), corners, leftPoses, rightPoses, consistent);
-    std::vector<CommonCorners> kept;
-    std::vector<std::size_t> keptPairs;
-    for (std::size_t k = 0; k < used.size(); ++k) {
-      if (consistent[k]) {
-        kept.push_back(std::move(corners[k]));
-        keptPairs.push_back(used[k]);
-      } else {
-        result.pairs[used[k]].rejected = "the two views disagree on the rig (not taken at the same moment?)";
-      }
-    }
-    corners = std::move(kept);
-    used = std::move(keptPairs);
   }
   const Eigen::Matrix3d rotation = result.rightFromLeft.rotationMatrix();
   const Eigen::Vector3d translation = result.rightFromLeft.translation();
@@ -319,7 +321,6 @@ StereoCalibrationResult calibrateStereo(const std::vector<CalibrationView>& left
   Eigen::Matrix<double, 6, 6> reduced = Eigen::Matrix<double, 6, 6>::Zero();
   double squared = 0;
   std::size_t observations = 0;
-  const Lens leftLens(lc), rightLens(rc);
   for (std::size_t k = 0; k < used.size(); ++k) {
     const CommonCorners& c = corners[k];
     const SE3d pose = refinePose(leftLens, rightLens, result.rightFromLeft, boardPose(lc, c.board, c.left), c);

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "error_message.hpp"
 #include "orbis/calibration/calibrate.hpp"
 #include "orbis/calibration/calibration_output.hpp"
 #include "orbis/io/settings.hpp"
@@ -145,15 +146,6 @@ TEST(Calibrate, PatternSpecErrors) {
   const CalibrationPattern p = parsePattern("charuco:7x5:0.04:0.03:DICT_5X5_100");
   EXPECT_EQ(p.cornerCount(), 24);
   EXPECT_EQ(parsePattern(p.describe()).dictionary, "DICT_5X5_100");
-}
-
-std::string messageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(Calibrate, BadInputsSayWhatToDo) {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "error_message.hpp"
 #include "orbis/calibration/calibration_output.hpp"
 #include "orbis/calibration/stereo_calibrate.hpp"
 #include "orbis/io/settings.hpp"
@@ -156,15 +157,6 @@ TEST(StereoCalibrate, FisheyeRigAt190DegreesRecovered) {
   const StereoCalibrationResult r = calibrateStereo(left, right, pattern, options, "rendered fisheye rig");
   expectRig(r, truth);
   expectSettingsRectify(r, truth, "fisheye");
-}
-
-std::string messageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(StereoCalibrate, MismatchedOrSwappedPairsSayWhatToDo) {

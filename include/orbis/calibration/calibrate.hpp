@@ -160,6 +160,11 @@ struct CalibrationResult {
   std::vector<std::string> warnings;
 };
 
+// The pose OpenCV's rotation vector and translation describe.
+SE3d poseFromRotationVector(const cv::Vec3d& rvec, const cv::Vec3d& tvec);
+// Pixels of `camera` undistorted to its normalised image plane (x/z, y/z).
+std::vector<cv::Point2f> undistortToPlane(const CalibratedCamera& camera, const std::vector<cv::Point2f>& pixels);
+
 // Calibrates from detected views (OpenCV's calibration for the chosen model), selecting views and
 // rejecting blurred, duplicate and outlier ones; throws orbis::Error naming source when too few
 // views or a degenerate set.

@@ -5,8 +5,9 @@
 //   1. calibrates each camera on its own with calibrate() (every view of that camera counts, with
 //      the same selection and rejection as a single camera);
 //   2. fits the rig's extrinsics (rightFromLeft: x_right = R x_left + t) over the pairs whose
-//      views both cameras kept, with the intrinsics fixed (OpenCV's stereoCalibrate, or
-//      fisheye::stereoCalibrate for Kannala-Brandt lenses), and gives the baseline's standard
+//      views both cameras kept, with the intrinsics fixed (orbis's Gauss-Newton over the rig and
+//      the board poses, pairs inconsistent with the others left out; for pinholes OpenCV's
+//      stereoCalibrate when it fits at least as well), and gives the baseline's standard
 //      deviation (residual σ times the square root of the inverse normal matrix, board poses
 //      marginalised, numeric Jacobian: the same quantity calibrate() reports per parameter);
 //   3. rectifies the pair (orbis::rectifyStereo: cv::stereoRectify, or fisheye::stereoRectify
