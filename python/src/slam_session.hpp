@@ -7,12 +7,12 @@
 // ValueError (size, timestamp); tracking after shutdown() raises orbis.Error.
 #pragma once
 
-#include <concepts>
 #include <pybind11/pybind11.h>
 
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <concepts>
 #include <limits>
 #include <memory>
 #include <mutex>
