@@ -124,7 +124,11 @@ void bindQueries(py::class_<SlamSession<Sensor>>& c) {
           "current"_a = false,
           "Per row of trajectory(): the map the frame was tracked in (current=True: the map holding it now).")
       .def_property_readonly("state", [](Session& s) { return s.locked([](S& slam) { return slam.state(); }); })
-      .def_property_readonly("camera", [](const Session& s) { return describeCamera(s.camera()); });
+      .def_property_readonly("camera", [](const Session& s) {
+        // A fisheye session's camera is described by its lens, as the settings name it.
+        if constexpr (ObservesThroughLens<typename Session::Camera>) return describeCamera(s.camera().lens);
+        else return describeCamera(s.camera());
+      });
   c.def(
       "stats",
       [](Session& s) {
