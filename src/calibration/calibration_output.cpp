@@ -11,7 +11,7 @@
 
 #include "orbis/calibration/stereo_calibrate.hpp"
 #include "orbis/features/orb_params.hpp"
-#include "orbis/io/image_file.hpp"
+#include "orbis/util/image_file.hpp"
 #include "orbis/util/atomic_file.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"

@@ -11,7 +11,7 @@
 
 #include "orbis/calibration/calibration_output.hpp"
 #include "orbis/calibration/stereo_calibrate.hpp"
-#include "orbis/io/image_file.hpp"
+#include "orbis/util/image_file.hpp"
 #include "orbis/synth/rng.hpp"
 #include "orbis/util/error.hpp"
 

@@ -10,7 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "orbis/features/orb_params.hpp"
-#include "orbis/io/image_file.hpp"
+#include "orbis/util/image_file.hpp"
 #include "orbis/io/trajectory.hpp"
 #include "orbis/util/enum_names.hpp"
 #include "orbis/util/error.hpp"

@@ -1,4 +1,4 @@
-// orbis/io/image_file.hpp — writing an image file with an orbis error on failure.
+// orbis/util/image_file.hpp — writing an image file with an orbis error on failure.
 //
 // Contract: writeImageFile writes image with OpenCV (the format from the file's extension) and
 // throws orbis::Error naming the file when OpenCV refuses or fails; it creates no folders.

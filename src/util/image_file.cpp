@@ -1,4 +1,4 @@
-#include "orbis/io/image_file.hpp"
+#include "orbis/util/image_file.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 
