@@ -17,6 +17,21 @@ KeyFrame::KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, co
       Tcw_(Tcw),
       points_(features_->size(), nullptr) {}
 
+KeyFrame::KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
+                   std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
+                   BowComputation computeBow)
+    : KeyFrame(id, frameIndex, timestamp, Tcw, std::move(features), intrinsics, {}, {}) {
+  pendingBow_ = std::move(computeBow);
+}
+
+void KeyFrame::ensureBow() const {
+  std::call_once(bowOnce_, [this] {
+    if (!pendingBow_) return;
+    pendingBow_(*features_, bow_, featureVector_);
+    pendingBow_ = nullptr;
+  });
+}
+
 void KeyFrame::erasePoint(const MapPoint* p) {
   for (auto& slot : points_)
     if (slot == p) slot = nullptr;

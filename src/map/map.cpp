@@ -6,8 +6,20 @@ KeyFrame* Map::createKeyFrame(std::uint64_t frameIndex, double timestamp, const 
                               std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
                               bow::BowVector bowVector, bow::FeatureVector featureVector) {
   const KeyFrameId id = keyFrames_.size();
-  keyFrames_.push_back(std::make_unique<KeyFrame>(id, frameIndex, timestamp, Tcw, std::move(features), intrinsics,
-                                                  std::move(bowVector), std::move(featureVector)));
+  return adopt(std::make_unique<KeyFrame>(id, frameIndex, timestamp, Tcw, std::move(features), intrinsics,
+                                          std::move(bowVector), std::move(featureVector)));
+}
+
+KeyFrame* Map::createKeyFrame(std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
+                              std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
+                              BowComputation computeBow) {
+  const KeyFrameId id = keyFrames_.size();
+  return adopt(std::make_unique<KeyFrame>(id, frameIndex, timestamp, Tcw, std::move(features), intrinsics,
+                                          std::move(computeBow)));
+}
+
+KeyFrame* Map::adopt(std::unique_ptr<KeyFrame> created) {
+  keyFrames_.push_back(std::move(created));
   KeyFrame* kf = keyFrames_.back().get();
   kf->setMapId(active_);
   // A map's first keyframe is its root: never culled, and the gauge its BA keeps fixed.

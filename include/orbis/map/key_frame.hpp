@@ -8,8 +8,10 @@
 // monocular keypoint, and the few camera numbers the map needs travel in MapIntrinsics.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <vector>
 
@@ -56,6 +58,11 @@ bool pointFromDepth(const Camera& camera, const FrameFeatures& features, std::si
   return true;
 }
 
+// Fills a keyframe's bag of words from its features. Tracking hands one to a keyframe instead of
+// the vectors, so the vocabulary lookup runs on the mapping thread (as in ORB-SLAM2) rather than
+// on the camera's critical path (docs/notes/2026-11-27-speed.md).
+using BowComputation = std::function<void(const FrameFeatures&, bow::BowVector&, bow::FeatureVector&)>;
+
 // A keyframe: an immutable frame (features, bag of words), its pose, its map points and its place
 // in the covisibility graph, the spanning tree and the loop edges (§III-B).
 class KeyFrame {
@@ -66,6 +73,10 @@ class KeyFrame {
   KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
            std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
            bow::BowVector bowVector, bow::FeatureVector featureVector);
+  // Made by Map::createKeyFrame, the bag of words computed by computeBow when first needed.
+  KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
+           std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
+           BowComputation computeBow);
 
   // Unique, increasing with creation.
   const KeyFrameId id;
@@ -79,11 +90,14 @@ class KeyFrame {
   // The frame's features (immutable).
   const FrameFeatures& features() const { return *features_; }
   // @{
-  // Keypoints, the bag of words and the node-grouped features.
+  // Keypoints, the bag of words and the node-grouped features (computed on first use when the
+  // keyframe was made with a BowComputation; any thread, no lock needed).
   std::size_t size() const { return points_.size(); }
-  const bow::BowVector& bowVector() const { return bow_; }
-  const bow::FeatureVector& featureVector() const { return featureVector_; }
+  const bow::BowVector& bowVector() const { ensureBow(); return bow_; }
+  const bow::FeatureVector& featureVector() const { ensureBow(); return featureVector_; }
   // @}
+  // Computes the bag of words now if it was left for later; once, whichever thread comes first.
+  void ensureBow() const;
 
   // ---- pose (camera-from-world) ------------------------------------------------------------
   // Camera from world.
@@ -187,8 +201,10 @@ class KeyFrame {
   void updateBestCovisibles();
 
   std::shared_ptr<const FrameFeatures> features_;
-  bow::BowVector bow_;
-  bow::FeatureVector featureVector_;
+  mutable std::once_flag bowOnce_;
+  mutable BowComputation pendingBow_;  // empty once the vectors are filled
+  mutable bow::BowVector bow_;
+  mutable bow::FeatureVector featureVector_;
   SE3d Tcw_;
   SE3d Tcp_;
   std::vector<MapPoint*> points_;

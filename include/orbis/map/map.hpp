@@ -60,6 +60,10 @@ class Map {
   KeyFrame* createKeyFrame(std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
                            std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
                            bow::BowVector bowVector, bow::FeatureVector featureVector);
+  // Creates a keyframe with the next id whose bag of words computeBow fills when first needed.
+  KeyFrame* createKeyFrame(std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
+                           std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
+                           BowComputation computeBow);
   // Creates a map point with the next id.
   MapPoint* createMapPoint(const Eigen::Vector3d& position, KeyFrame* reference, std::uint64_t frameIndex);
 
@@ -115,6 +119,9 @@ class Map {
   void restoreAtlas(std::vector<AtlasMapRecord> records, std::uint32_t active);
 
  private:
+  // Takes a new keyframe in: its map and, for a map's first, the root mark.
+  KeyFrame* adopt(std::unique_ptr<KeyFrame> created);
+
   mutable std::mutex mutex_;
   std::vector<std::unique_ptr<KeyFrame>> keyFrames_;  // index == id
   std::vector<std::unique_ptr<MapPoint>> points_;     // index == id

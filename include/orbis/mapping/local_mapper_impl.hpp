@@ -140,6 +140,12 @@ bool LocalMapper<Sensor>::processOne() {
   note("frame", static_cast<double>(kf->frameIndex));
   note("queued", static_cast<double>(queuedKeyFrames()));
   {
+    // Tracking leaves a keyframe's bag of words to this thread; computed outside the map's lock
+    // (the features are immutable), so tracking is not held up by it.
+    ScopedStage stage(timer_, "mapping: bag of words");
+    kf->ensureBow();
+  }
+  {
     ScopedStage stage(timer_, "mapping: keyframe insertion");
     std::lock_guard lock(map_.mutex());
     processNewKeyFrame(kf);

@@ -530,9 +530,21 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
 template <SensorConfiguration Sensor>
 void Tracker<Sensor>::createNewKeyFrame() {
   if (mapper_ && !mapper_->setNotStop(true)) return;
-  computeBow(current_);
-  KeyFrame* kf = map_.createKeyFrame(current_.index, current_.timestamp, current_.Tcw, current_.features,
-                                     current_.intrinsics, current_.bow, current_.featureVector);
+  KeyFrame* kf = nullptr;
+  if (current_.hasBow) {
+    kf = map_.createKeyFrame(current_.index, current_.timestamp, current_.Tcw, current_.features,
+                             current_.intrinsics, current_.bow, current_.featureVector);
+  } else {
+    // The vocabulary lookup is left to the mapping thread (LocalMapper::processOne), or to
+    // whichever thread needs the words first; the vocabulary outlives the map (SlamCore owns both).
+    kf = map_.createKeyFrame(current_.index, current_.timestamp, current_.Tcw, current_.features,
+                             current_.intrinsics,
+                             [&vocabulary = vocabulary_, levelsUp = options_.bowLevelsUp](
+                                 const FrameFeatures& features, bow::BowVector& bow, bow::FeatureVector& nodes) {
+                               vocabulary.transform(std::span<const OrbDescriptor>(features.descriptors), bow,
+                                                    nodes, levelsUp);
+                             });
+  }
   reference_ = kf;
   // The frame's matches pass to the keyframe, outliers included: local BA has the last word.
   for (std::size_t i = 0; i < current_.size(); ++i)
