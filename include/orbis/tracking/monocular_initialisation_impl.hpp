@@ -156,12 +156,8 @@ bool Tracker<Sensor>::createInitialMap(FrameT& f, const std::vector<std::pair<st
   const double scale = 1.0 / median;
   first.Tcw = SE3d();
   f.Tcw = SE3d(pair.secondPose.so3(), pair.secondPose.translation() * scale);
-  computeBow(first);
-  computeBow(f);
-  KeyFrame* kf1 = map_.createKeyFrame(first.index, first.timestamp, first.Tcw, first.features, first.intrinsics,
-                                      first.bow, first.featureVector);
-  KeyFrame* kf2 =
-      map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics, f.bow, f.featureVector);
+  KeyFrame* kf1 = createKeyFrameFrom(first);
+  KeyFrame* kf2 = createKeyFrameFrom(f);
   for (std::size_t l = 0; l < pair.points.size(); ++l) {
     const auto [i1, i2] = pair.matches[l];
     MapPoint* p = map_.createMapPoint(pair.points[l] * scale, kf2, f.index);

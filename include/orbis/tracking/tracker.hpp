@@ -147,6 +147,9 @@ class Tracker {
 
  private:
   void computeBow(FrameT& f) const;
+  // A keyframe of frame f in the active map: with f's words when it has them, else with their
+  // computation left to whichever thread needs them first (the mapping thread, normally).
+  KeyFrame* createKeyFrameFrom(const FrameT& f);
   bool bootstrap(FrameT& f)
     requires(Sensor::kMetricScale);
   // Monocular (monocular_initialisation_impl.hpp); constrained so that the explicit

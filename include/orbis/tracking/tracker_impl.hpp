@@ -65,6 +65,19 @@ void Tracker<Sensor>::computeBow(FrameT& f) const {
 }
 
 template <SensorConfiguration Sensor>
+KeyFrame* Tracker<Sensor>::createKeyFrameFrom(const FrameT& f) {
+  if (f.hasBow) return map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics, f.bow, f.featureVector);
+  // The vocabulary lookup is left to the mapping thread (LocalMapper::processOne), or to whichever
+  // thread needs the words first; the vocabulary outlives the map (SlamCore owns both).
+  return map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics,
+                             [&vocabulary = vocabulary_, levelsUp = options_.bowLevelsUp](
+                                 const FrameFeatures& features, bow::BowVector& bow, bow::FeatureVector& nodes) {
+                               vocabulary.transform(std::span<const OrbDescriptor>(features.descriptors), bow,
+                                                    nodes, levelsUp);
+                             });
+}
+
+template <SensorConfiguration Sensor>
 TrackResult Tracker<Sensor>::track(FrameT frame) {
   std::lock_guard lock(map_.mutex());
   current_ = std::move(frame);
@@ -224,8 +237,7 @@ bool Tracker<Sensor>::bootstrap(FrameT& f)
   // ORB-SLAM2 starts on any frame with more than 500 keypoints; the map gets those with depth.
   if (static_cast<int>(f.size()) <= options_.minBootstrapFeatures) return false;
   f.Tcw = SE3d();
-  computeBow(f);
-  KeyFrame* kf = map_.createKeyFrame(f.index, f.timestamp, f.Tcw, f.features, f.intrinsics, f.bow, f.featureVector);
+  KeyFrame* kf = createKeyFrameFrom(f);
   for (std::size_t i = 0; i < f.size(); ++i) tracking_detail::createPointFromDepth(map_, f, kf, i);
   reference_ = kf;
   lastKeyFrameFrame_ = f.index;
@@ -530,21 +542,7 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
 template <SensorConfiguration Sensor>
 void Tracker<Sensor>::createNewKeyFrame() {
   if (mapper_ && !mapper_->setNotStop(true)) return;
-  KeyFrame* kf = nullptr;
-  if (current_.hasBow) {
-    kf = map_.createKeyFrame(current_.index, current_.timestamp, current_.Tcw, current_.features,
-                             current_.intrinsics, current_.bow, current_.featureVector);
-  } else {
-    // The vocabulary lookup is left to the mapping thread (LocalMapper::processOne), or to
-    // whichever thread needs the words first; the vocabulary outlives the map (SlamCore owns both).
-    kf = map_.createKeyFrame(current_.index, current_.timestamp, current_.Tcw, current_.features,
-                             current_.intrinsics,
-                             [&vocabulary = vocabulary_, levelsUp = options_.bowLevelsUp](
-                                 const FrameFeatures& features, bow::BowVector& bow, bow::FeatureVector& nodes) {
-                               vocabulary.transform(std::span<const OrbDescriptor>(features.descriptors), bow,
-                                                    nodes, levelsUp);
-                             });
-  }
+  KeyFrame* kf = createKeyFrameFrom(current_);
   reference_ = kf;
   // The frame's matches pass to the keyframe, outliers included: local BA has the last word.
   for (std::size_t i = 0; i < current_.size(); ++i)
