@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <variant>
 
 #include "orbis/util/error.hpp"
+#include "orbis/util/image_file.hpp"
 
 namespace orbis::eval {
 namespace {
@@ -273,13 +273,7 @@ void writePng(const std::filesystem::path& file, const std::vector<Primitive>& f
   }
   cv::Mat image;
   cv::resize(canvas, image, cv::Size(kWidth, kHeight), 0, 0, cv::INTER_AREA);
-  bool written = false;
-  try {
-    written = cv::imwrite(file.string(), image);
-  } catch (const cv::Exception& e) {
-    throw fileError(file.string(), std::string("cannot write the PNG: ") + e.what());
-  }
-  if (!written) throw fileError(file.string(), "cannot write the PNG");
+  writeImageFile(file, image);
 }
 
 }  // namespace

@@ -5,10 +5,9 @@
 #include <cmath>
 #include <limits>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "orbis/util/error.hpp"
+#include "orbis/util/image_file.hpp"
 
 namespace orbis {
 
@@ -105,13 +104,7 @@ void writeOverview(const std::filesystem::path& file, const OverviewScene& scene
   char label[32];
   std::snprintf(label, sizeof label, "%g m", bar);
   cv::putText(canvas, label, cv::Point(20, size - 28), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  bool written = false;
-  try {
-    written = cv::imwrite(file.string(), img);
-  } catch (const cv::Exception& e) {
-    throw fileError(file.string(), std::string("cannot write image: ") + e.what());
-  }
-  if (!written) throw fileError(file.string(), "cannot write image");
+  writeImageFile(file, img);
 }
 
 }  // namespace orbis
