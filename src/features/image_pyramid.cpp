@@ -33,23 +33,33 @@ void ImagePyramid::fillBorder(cv::Mat& bordered, int border) {
 }
 
 void ImagePyramid::build(const cv::Mat& gray8u, const ScaleLevels& levels) {
-  CV_Assert(gray8u.type() == CV_8UC1);
+  allocate(gray8u.size(), levels);
+  for (int l = 0; l < this->levels(); ++l) buildLevel(l, gray8u);
+}
+
+void ImagePyramid::allocate(cv::Size size0, const ScaleLevels& levels) {
   const auto n = static_cast<std::size_t>(levels.levels());
   bordered_.resize(n);
   interior_.resize(n);
   for (std::size_t l = 0; l < n; ++l) {
     // At least one pixel, so tiny inputs give tiny levels rather than an OpenCV assertion.
-    const cv::Size size(std::max(1, static_cast<int>(std::lround(gray8u.cols * levels.invScale[l]))),
-                        std::max(1, static_cast<int>(std::lround(gray8u.rows * levels.invScale[l]))));
+    const cv::Size size(std::max(1, static_cast<int>(std::lround(size0.width * levels.invScale[l]))),
+                        std::max(1, static_cast<int>(std::lround(size0.height * levels.invScale[l]))));
     bordered_[l].create(size.height + 2 * kBorder, size.width + 2 * kBorder, CV_8UC1);
     interior_[l] = bordered_[l](cv::Rect(kBorder, kBorder, size.width, size.height));
-    if (l == 0) {
-      gray8u.copyTo(interior_[l]);
-    } else {
-      cv::resize(interior_[l - 1], interior_[l], size, 0, 0, cv::INTER_LINEAR);
-    }
-    fillBorder(bordered_[l], kBorder);
   }
+}
+
+void ImagePyramid::buildLevel(int l, const cv::Mat& gray8u) {
+  CV_Assert(gray8u.type() == CV_8UC1);
+  const auto i = static_cast<std::size_t>(l);
+  if (l == 0) {
+    CV_Assert(gray8u.size() == interior_[0].size());
+    gray8u.copyTo(interior_[0]);
+  } else {
+    cv::resize(interior_[i - 1], interior_[i], interior_[i].size(), 0, 0, cv::INTER_LINEAR);
+  }
+  fillBorder(bordered_[i], kBorder);
 }
 
 }  // namespace orbis

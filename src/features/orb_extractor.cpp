@@ -4,7 +4,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <future>
+#include <exception>
+#include <memory>
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -402,22 +403,13 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
   keypoints.clear();
   descriptors.clear();
   if (gray.empty()) return;
-  pyramid_.build(gray, scales_);
   const int n = levels();
   levelKeypoints_.resize(static_cast<std::size_t>(n));
   levelDescriptors_.resize(static_cast<std::size_t>(n));
   if (parallelLevels_ && n > 1) {
-    // Levels are taken in order by whichever thread is free: level 0 (a third of the work) on
-    // one, levels 1, 2, ... on the other until it is done. Which thread does a level changes
-    // nothing in its output.
-    std::atomic<int> next{0};
-    auto work = [&](LevelScratch& s) {
-      for (int l = next++; l < n; l = next++) extractLevel(l, s);
-    };
-    auto helper = std::async(std::launch::async, [&] { work(scratch_[1]); });
-    work(scratch_[0]);
-    helper.get();
+    extractLevelsInParallel(gray);
   } else {
+    pyramid_.build(gray, scales_);
     for (int l = 0; l < n; ++l) extractLevel(l, scratch_[0]);
   }
   std::size_t total = 0;
@@ -429,6 +421,58 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
     keypoints.insert(keypoints.end(), levelKeypoints_[level].begin(), levelKeypoints_[level].end());
     descriptors.insert(descriptors.end(), levelDescriptors_[level].begin(), levelDescriptors_[level].end());
   }
+}
+
+void OrbExtractor::extractLevelsInParallel(const cv::Mat& gray) {
+  // The helper starts on level 0 as soon as it is built, while this thread builds the rest of
+  // the pyramid (each level from the one before); then levels are taken in order by whichever
+  // thread is free. Which thread does a level changes nothing in its output.
+  const int n = levels();
+  pyramid_.allocate(gray.size(), scales_);
+  std::atomic<int> built{0};  // levels 0 .. built - 1 are ready to read; n + 1: stop, nothing more comes
+  std::atomic<int> next{0};
+  auto work = [&](LevelScratch& s) {
+    for (int l = next++; l < n; l = next++) {
+      int ready = built.load(std::memory_order_acquire);
+      for (; ready <= l; ready = built.load(std::memory_order_acquire)) built.wait(ready, std::memory_order_acquire);
+      if (ready > n) return;
+      extractLevel(l, s);
+    }
+  };
+  if (!helper_) helper_ = std::make_unique<HelperThread>();
+  pyramid_.buildLevel(0, gray);
+  built.store(1, std::memory_order_release);
+  std::exception_ptr helperError;
+  helper_->run([&] {
+    try {
+      work(scratch_[1]);
+    } catch (...) {
+      helperError = std::current_exception();
+    }
+  });
+  {
+    HelperThread::JoinGuard joinHelper(*helper_);
+    // Declared after the join guard so it runs first: a throw below must not leave the helper
+    // waiting for a level that will never be built.
+    struct ReleaseOnThrow {
+      std::atomic<int>& built;
+      int stop;
+      int uncaught = std::uncaught_exceptions();
+      ~ReleaseOnThrow() {
+        if (std::uncaught_exceptions() > uncaught) {
+          built.store(stop, std::memory_order_release);
+          built.notify_all();
+        }
+      }
+    } release{built, n + 1};
+    for (int l = 1; l < n; ++l) {
+      pyramid_.buildLevel(l, gray);
+      built.store(l + 1, std::memory_order_release);
+      built.notify_all();
+    }
+    work(scratch_[0]);
+  }
+  if (helperError) std::rethrow_exception(helperError);
 }
 
 void OrbExtractor::extractLevel(int l, LevelScratch& s) {

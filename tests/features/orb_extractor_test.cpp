@@ -161,6 +161,39 @@ TEST(OrbExtractor, PerLevelBudgetIsGeometric) {
   EXPECT_EQ(n[0], 217);  // 1000 (1 - 1/1.2) / (1 - 1.2^-8)
 }
 
+// Levels shared with the extractor's helper thread (which starts on level 0 while the caller
+// builds the pyramid) give the serial extractor's keypoints and descriptors, bit for bit, frame
+// after frame and when the image size changes between frames.
+TEST(OrbExtractor, ParallelLevelsGiveTheSerialBits) {
+  OrbParams p;
+  p.features = 1000;
+  OrbExtractor serial(p), parallel(p);
+  parallel.setParallelLevels(true);
+  const cv::Size sizes[] = {{640, 480}, {640, 480}, {1241, 376}, {320, 240}, {640, 480}};
+  std::uint64_t seed = 3;
+  for (const cv::Size& size : sizes) {
+    cv::Mat image = test::texturedImage(size.width, size.height, seed++);
+    if (seed % 2 == 0) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
+    std::vector<Keypoint> serialKeypoints, parallelKeypoints;
+    std::vector<OrbDescriptor> serialDescriptors, parallelDescriptors;
+    serial.extract(image, serialKeypoints, serialDescriptors);
+    parallel.extract(image, parallelKeypoints, parallelDescriptors);
+    ASSERT_GT(serialKeypoints.size(), 500u) << size;
+    ASSERT_EQ(serialKeypoints.size(), parallelKeypoints.size()) << size;
+    for (std::size_t i = 0; i < serialKeypoints.size(); ++i) {
+      const Keypoint &a = serialKeypoints[i], &b = parallelKeypoints[i];
+      ASSERT_TRUE(a.u == b.u && a.v == b.v && a.angle == b.angle && a.response == b.response && a.octave == b.octave)
+          << size << " keypoint " << i;
+    }
+    EXPECT_TRUE(serialDescriptors == parallelDescriptors) << size;
+    for (int l = 0; l < serial.levels(); ++l)
+      EXPECT_EQ(cv::norm(serial.pyramid()[static_cast<std::size_t>(l)], parallel.pyramid()[static_cast<std::size_t>(l)],
+                         cv::NORM_INF),
+                0.0)
+          << size << " level " << l;
+  }
+}
+
 // Share of 32x32 cells with a keypoint: the quadtree must spread better than cv::ORB's
 // strongest-first selection.
 double coverage(const std::vector<Keypoint>& kps, cv::Size size) {

@@ -5,7 +5,9 @@
 // ORB-SLAM does). level(l) is a view of the interior; kBorder pixels around it are valid
 // memory filled by reflection (BORDER_REFLECT_101), so patch operations near the image edge
 // (orientation, rotated BRIEF, stereo patch correlation) read defined values. Buffers are kept
-// between calls: rebuilding at the same image size allocates nothing.
+// between calls: rebuilding at the same image size allocates nothing. build() is allocate() then
+// buildLevel(0), buildLevel(1), ... in order; a level may be read on another thread once its
+// buildLevel() has returned (and that return is visible there), while later levels are built.
 #pragma once
 
 #include <span>
@@ -47,6 +49,12 @@ class ImagePyramid {
 
   // Builds every level from an 8-bit grey image.
   void build(const cv::Mat& gray8u, const ScaleLevels& levels);
+  // @{
+  // build() in steps: the buffers for an image of `size`, then level l from the image (l = 0) or
+  // from level l - 1, which must be built already.
+  void allocate(cv::Size size, const ScaleLevels& levels);
+  void buildLevel(int l, const cv::Mat& gray8u);
+  // @}
   // @{
   // The levels (without border), one level, all of them, and a level's coordinate map.
   int levels() const { return static_cast<int>(interior_.size()); }

@@ -11,14 +11,16 @@
 // ordered by level. The total may exceed the budget by a few (the quadtree splits four ways)
 // and falls short on images with too few corners.
 // Deterministic; not thread-safe (one extractor per image stream: buffers are reused). With
-// setParallelLevels(true) the levels after the pyramid are shared between the caller's thread
-// and one more (each level's corners, quadtree and descriptors depend on that level alone, so
-// the output is bit-identical to the serial one); for an extractor that runs alone on a frame
-// (monocular, RGB-D), not one of a stereo pair that already runs on two threads.
+// setParallelLevels(true) the levels are shared between the caller's thread and a helper kept by
+// the extractor, which starts on level 0 while the caller builds the rest of the pyramid (each
+// level's corners, quadtree and descriptors depend on that level alone, so the output is
+// bit-identical to the serial one); for an extractor that runs alone on a frame (monocular,
+// RGB-D), not one of a stereo pair that already runs on two threads.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -29,6 +31,7 @@
 #include "orbis/features/image_pyramid.hpp"
 #include "orbis/features/keypoint.hpp"
 #include "orbis/features/orb_params.hpp"
+#include "orbis/util/helper_thread.hpp"
 
 namespace orbis {
 
@@ -89,6 +92,7 @@ class OrbExtractor : public PyramidExtractorBase {
     std::vector<int> cellCount, selected, splittable;
   };
 
+  void extractLevelsInParallel(const cv::Mat& gray);
   void extractLevel(int l, LevelScratch& s);
   void detectCorners(const cv::Mat& level, LevelScratch& s) const;
   static void distribute(LevelScratch& s, int wanted, float minX, float minY, float maxX, float maxY);
@@ -102,6 +106,7 @@ class OrbExtractor : public PyramidExtractorBase {
   std::vector<std::vector<Keypoint>> levelKeypoints_;        // per level, before concatenation
   std::vector<std::vector<OrbDescriptor>> levelDescriptors_;
   bool parallelLevels_ = false;
+  std::unique_ptr<HelperThread> helper_;  // the second thread of setParallelLevels(true), kept between frames
 };
 
 static_assert(FeatureExtractor<OrbExtractor>);

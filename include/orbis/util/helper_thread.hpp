@@ -1,0 +1,87 @@
+// orbis/util/helper_thread.hpp — one persistent thread that runs one job at a time: fork-join
+// work on every frame, where starting a thread each time would cost more than waking one.
+//
+// Contract: run(job) hands `job` to the thread and returns at once; join() returns when it has
+// returned. One owner calls run() and join() (not thread-safe); every run() is followed by a
+// join() before the next run() and before anything the job refers to goes away (JoinGuard does
+// it on every path out of a scope). The thread starts on the first run() and is joined by the
+// destructor. The job must not throw. Everything the job did happens-before join()'s return.
+#pragma once
+
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+namespace orbis {
+
+// A thread kept between jobs, for fork-join work per frame.
+class HelperThread {
+ public:
+  HelperThread() = default;
+  HelperThread(const HelperThread&) = delete;
+  HelperThread& operator=(const HelperThread&) = delete;
+  ~HelperThread() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  // Starts `job` on the helper thread.
+  void run(std::function<void()> job) {
+    {
+      std::lock_guard lock(mutex_);
+      job_ = std::move(job);
+      pending_ = true;
+    }
+    if (!thread_.joinable()) thread_ = std::thread([this] { serve(); });
+    wake_.notify_one();
+  }
+
+  // Waits until the job run() started has returned.
+  void join() {
+    std::unique_lock lock(mutex_);
+    done_.wait(lock, [this] { return !pending_; });
+  }
+
+  // Joins the helper when the scope ends, also when the owner's share of the work throws.
+  class JoinGuard {
+   public:
+    explicit JoinGuard(HelperThread& helper) : helper_(helper) {}
+    JoinGuard(const JoinGuard&) = delete;
+    JoinGuard& operator=(const JoinGuard&) = delete;
+    ~JoinGuard() { helper_.join(); }
+
+   private:
+    HelperThread& helper_;
+  };
+
+ private:
+  void serve() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [this] { return stop_ || (pending_ && job_); });
+      if (stop_ && !pending_) return;
+      std::function<void()> job = std::move(job_);
+      job_ = nullptr;
+      lock.unlock();
+      job();
+      lock.lock();
+      pending_ = false;
+      done_.notify_one();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  std::function<void()> job_;
+  bool pending_ = false;  // a job was handed over and has not returned yet
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+}  // namespace orbis
