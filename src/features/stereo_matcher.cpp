@@ -7,6 +7,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <memory>
 
 namespace orbis {
 namespace {
@@ -42,9 +43,40 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
   uRight.assign(n, -1.f);
   depth.assign(n, -1.f);
   if (n == 0 || right.keypoints.empty() || left.pyramid.empty() || right.pyramid.empty()) return;
+  indexRightRows(right, scales, left.pyramid[0].rows);
 
+  // Each left keypoint's match depends on that keypoint alone, so the two halves can run on two
+  // threads; the costs are then gathered in keypoint order, as one thread would.
+  cost_.assign(n, -1);
+  auto matchRange = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t iL = begin; iL < end; ++iL) matchOne(left, right, bf, minDepth, iL, uRight, depth);
+  };
+  if (parallel_ && n >= kMinKeypointsForTwoThreads) {
+    if (!helper_) helper_ = std::make_unique<HelperThread>();
+    helper_->run([&] { matchRange(n / 2, n); });
+    HelperThread::JoinGuard joinHelper(*helper_);
+    matchRange(0, n / 2);
+  } else {
+    matchRange(0, n);
+  }
+  costAndIndex_.clear();
+  for (std::size_t iL = 0; iL < n; ++iL)
+    if (cost_[iL] >= 0) costAndIndex_.emplace_back(cost_[iL], static_cast<int>(iL));
+
+  if (costAndIndex_.empty()) return;
+  std::sort(costAndIndex_.begin(), costAndIndex_.end());
+  const float median = static_cast<float>(costAndIndex_[costAndIndex_.size() / 2].first);
+  const float threshold = kOutlierFactor * median;
+  for (auto it = costAndIndex_.rbegin(); it != costAndIndex_.rend(); ++it) {
+    if (static_cast<float>(it->first) <= threshold) break;
+    uRight[static_cast<std::size_t>(it->second)] = -1.f;
+    depth[static_cast<std::size_t>(it->second)] = -1.f;
+  }
+}
+
+void StereoMatcher::indexRightRows(const StereoView& right, const ScaleLevels& scales, int rows) {
   // Right keypoints indexed by every image row their band covers (flat CSR layout).
-  const int rows = left.pyramid[0].rows;
+  rows_ = rows;
   rowStart_.assign(static_cast<std::size_t>(rows) + 1, 0);
   auto bandOf = [&](const Keypoint& k) {
     const float r = kRowBand * scales.scale[static_cast<std::size_t>(k.octave)];
@@ -62,101 +94,96 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
     const auto [r0, r1] = bandOf(right.keypoints[i]);
     for (int y = r0; y <= r1; ++y) rowEntries_[static_cast<std::size_t>(rowFill_[static_cast<std::size_t>(y)]++)] = static_cast<int>(i);
   }
+}
 
+int StereoMatcher::bestRightCandidate(const StereoView& left, const StereoView& right, std::size_t iL,
+                                      float maxDisparity) const {
+  const Keypoint& kl = left.keypoints[iL];
+  const int level = kl.octave;
+  const auto row = static_cast<std::size_t>(kl.v);
+  const float minU = kl.u - maxDisparity, maxU = kl.u;
+  int bestDistance = kMaxDescriptorDistance;
+  int bestRight = -1;
+  const OrbDescriptor& dl = left.descriptors[iL];
+  for (int e = rowStart_[row]; e < rowStart_[row + 1]; ++e) {
+    const int iR = rowEntries_[static_cast<std::size_t>(e)];
+    const Keypoint& kr = right.keypoints[static_cast<std::size_t>(iR)];
+    if (kr.octave < level - 1 || kr.octave > level + 1) continue;
+    if (kr.u < minU || kr.u > maxU) continue;
+    const int d = hammingDistance(dl, right.descriptors[static_cast<std::size_t>(iR)]);
+    if (d < bestDistance) {
+      bestDistance = d;
+      bestRight = iR;
+    }
+  }
+  return bestRight;
+}
+
+void StereoMatcher::matchOne(const StereoView& left, const StereoView& right, float bf, float minDepth, std::size_t iL,
+                             std::vector<float>& uRight, std::vector<float>& depth) {
   const float minDisparity = 0.f;
   const float maxDisparity = bf / minDepth;
-  costAndIndex_.clear();
+  const Keypoint& kl = left.keypoints[iL];
+  const int level = kl.octave;
+  const int row = static_cast<int>(kl.v);
+  if (row < 0 || row >= rows_) return;
+  if (kl.u - minDisparity < 0.f) return;
+  const int bestRight = bestRightCandidate(left, right, iL, maxDisparity);
+  if (bestRight < 0) return;
 
-  for (std::size_t iL = 0; iL < n; ++iL) {
-    const Keypoint& kl = left.keypoints[iL];
-    const int level = kl.octave;
-    const int row = static_cast<int>(kl.v);
-    if (row < 0 || row >= rows) continue;
-    const float minU = kl.u - maxDisparity, maxU = kl.u - minDisparity;
-    if (maxU < 0.f) continue;
-
-    int bestDistance = kMaxDescriptorDistance;
-    int bestRight = -1;
-    const OrbDescriptor& dl = left.descriptors[iL];
-    for (int e = rowStart_[static_cast<std::size_t>(row)]; e < rowStart_[static_cast<std::size_t>(row) + 1]; ++e) {
-      const int iR = rowEntries_[static_cast<std::size_t>(e)];
-      const Keypoint& kr = right.keypoints[static_cast<std::size_t>(iR)];
-      if (kr.octave < level - 1 || kr.octave > level + 1) continue;
-      if (kr.u < minU || kr.u > maxU) continue;
-      const int d = hammingDistance(dl, right.descriptors[static_cast<std::size_t>(iR)]);
-      if (d < bestDistance) {
-        bestDistance = d;
-        bestRight = iR;
-      }
+  // Sub-pixel refinement by patch correlation on the left keypoint's level.
+  const cv::Mat& imL = left.pyramid[static_cast<std::size_t>(level)];
+  const cv::Mat& imR = right.pyramid[static_cast<std::size_t>(level)];
+  // Level <-> level-0 coordinates (two divisions: nothing beside the 11-position SAD below).
+  const PyramidLevelMap mapL = PyramidLevelMap::between(left.pyramid[0], imL);
+  const PyramidLevelMap mapR = PyramidLevelMap::between(right.pyramid[0], imR);
+  const int uL = cvRound(mapL.fromBaseX(kl.u)), vL = cvRound(mapL.fromBaseY(kl.v));
+  const int uR0 = cvRound(mapR.fromBaseX(right.keypoints[static_cast<std::size_t>(bestRight)].u));
+  if (uR0 - kSlide - kPatchHalf < 0 || uR0 + kSlide + kPatchHalf >= imR.cols) return;
+  if (vL - kPatchHalf < 0 || vL + kPatchHalf >= imL.rows || uL - kPatchHalf < 0 || uL + kPatchHalf >= imL.cols) return;
+  const std::uint8_t* patchL = imL.ptr<std::uint8_t>(vL) + uL;
+  const std::uint8_t* rowR = imR.ptr<std::uint8_t>(vL);
+  const int stepL = static_cast<int>(imL.step), stepR = static_cast<int>(imR.step);
+  // Patch sums from column sums: the left patch's once, the right one's slid along the row.
+  int sumL = 0;
+  for (int dx = -kPatchHalf; dx <= kPatchHalf; ++dx) sumL += columnSum(patchL, stepL, dx);
+  int columnsR[2 * (kSlide + kPatchHalf) + 1];
+  for (int x = -kSlide - kPatchHalf; x <= kSlide + kPatchHalf; ++x)
+    columnsR[x + kSlide + kPatchHalf] = columnSum(rowR + uR0, stepR, x);
+  int sumR = 0;
+  for (int x = 0; x < 2 * kPatchHalf + 1; ++x) sumR += columnsR[x];
+  int costs[2 * kSlide + 1];
+  int bestCost = INT_MAX, bestShift = 0;
+  for (int s = -kSlide; s <= kSlide; ++s) {
+    if (s > -kSlide) sumR += columnsR[s + kSlide + 2 * kPatchHalf] - columnsR[s + kSlide - 1];
+    const int c = zeroMeanSad(patchL, stepL, rowR + uR0 + s, stepR, sumL - sumR);
+    costs[s + kSlide] = c;
+    if (c < bestCost) {
+      bestCost = c;
+      bestShift = s;
     }
-    if (bestRight < 0) continue;
-
-    // Sub-pixel refinement by patch correlation on the left keypoint's level.
-    const cv::Mat& imL = left.pyramid[static_cast<std::size_t>(level)];
-    const cv::Mat& imR = right.pyramid[static_cast<std::size_t>(level)];
-    // Level <-> level-0 coordinates (two divisions: nothing beside the 11-position SAD below).
-    const PyramidLevelMap mapL = PyramidLevelMap::between(left.pyramid[0], imL);
-    const PyramidLevelMap mapR = PyramidLevelMap::between(right.pyramid[0], imR);
-    const int uL = cvRound(mapL.fromBaseX(kl.u)), vL = cvRound(mapL.fromBaseY(kl.v));
-    const int uR0 = cvRound(mapR.fromBaseX(right.keypoints[static_cast<std::size_t>(bestRight)].u));
-    if (uR0 - kSlide - kPatchHalf < 0 || uR0 + kSlide + kPatchHalf >= imR.cols) continue;
-    if (vL - kPatchHalf < 0 || vL + kPatchHalf >= imL.rows || uL - kPatchHalf < 0 ||
-        uL + kPatchHalf >= imL.cols)
-      continue;
-    const std::uint8_t* patchL = imL.ptr<std::uint8_t>(vL) + uL;
-    const std::uint8_t* rowR = imR.ptr<std::uint8_t>(vL);
-    const int stepL = static_cast<int>(imL.step), stepR = static_cast<int>(imR.step);
-    // Patch sums from column sums: the left patch's once, the right one's slid along the row.
-    int sumL = 0;
-    for (int dx = -kPatchHalf; dx <= kPatchHalf; ++dx) sumL += columnSum(patchL, stepL, dx);
-    int columnsR[2 * (kSlide + kPatchHalf) + 1];
-    for (int x = -kSlide - kPatchHalf; x <= kSlide + kPatchHalf; ++x)
-      columnsR[x + kSlide + kPatchHalf] = columnSum(rowR + uR0, stepR, x);
-    int sumR = 0;
-    for (int x = 0; x < 2 * kPatchHalf + 1; ++x) sumR += columnsR[x];
-    int costs[2 * kSlide + 1];
-    int bestCost = INT_MAX, bestShift = 0;
-    for (int s = -kSlide; s <= kSlide; ++s) {
-      if (s > -kSlide) sumR += columnsR[s + kSlide + 2 * kPatchHalf] - columnsR[s + kSlide - 1];
-      const int c = zeroMeanSad(patchL, stepL, rowR + uR0 + s, stepR, sumL - sumR);
-      costs[s + kSlide] = c;
-      if (c < bestCost) {
-        bestCost = c;
-        bestShift = s;
-      }
-    }
-    if (bestShift == -kSlide || bestShift == kSlide) continue;  // minimum not bracketed
-
-    const float c1 = static_cast<float>(costs[kSlide + bestShift - 1]);
-    const float c2 = static_cast<float>(costs[kSlide + bestShift]);
-    const float c3 = static_cast<float>(costs[kSlide + bestShift + 1]);
-    const float curvature = 2.f * (c1 + c3 - 2.f * c2);
-    if (curvature <= 0.f) continue;  // flat: no reliable minimum
-    const float delta = (c1 - c3) / curvature;
-    if (delta < -1.f || delta > 1.f) continue;
-
-    float uR = mapR.toBaseX(static_cast<float>(uR0 + bestShift) + delta);
-    float disparity = kl.u - uR;
-    if (disparity < minDisparity || disparity >= maxDisparity) continue;
-    if (disparity <= 0.f) {
-      // A point at infinity: keep it as (nearly) zero disparity rather than lose it.
-      disparity = 0.01f;
-      uR = kl.u - disparity;
-    }
-    uRight[iL] = uR;
-    depth[iL] = bf / disparity;
-    costAndIndex_.emplace_back(bestCost, static_cast<int>(iL));
   }
+  if (bestShift == -kSlide || bestShift == kSlide) return;  // minimum not bracketed
 
-  if (costAndIndex_.empty()) return;
-  std::sort(costAndIndex_.begin(), costAndIndex_.end());
-  const float median = static_cast<float>(costAndIndex_[costAndIndex_.size() / 2].first);
-  const float threshold = kOutlierFactor * median;
-  for (auto it = costAndIndex_.rbegin(); it != costAndIndex_.rend(); ++it) {
-    if (static_cast<float>(it->first) <= threshold) break;
-    uRight[static_cast<std::size_t>(it->second)] = -1.f;
-    depth[static_cast<std::size_t>(it->second)] = -1.f;
+  const float c1 = static_cast<float>(costs[kSlide + bestShift - 1]);
+  const float c2 = static_cast<float>(costs[kSlide + bestShift]);
+  const float c3 = static_cast<float>(costs[kSlide + bestShift + 1]);
+  const float curvature = 2.f * (c1 + c3 - 2.f * c2);
+  if (curvature <= 0.f) return;  // flat: no reliable minimum
+  const float delta = (c1 - c3) / curvature;
+  if (delta < -1.f || delta > 1.f) return;
+
+  float uR = mapR.toBaseX(static_cast<float>(uR0 + bestShift) + delta);
+  float disparity = kl.u - uR;
+  if (disparity < minDisparity || disparity >= maxDisparity) return;
+  if (disparity <= 0.f) {
+    // A point at infinity: keep it as (nearly) zero disparity rather than lose it.
+    disparity = 0.01f;
+    uR = kl.u - disparity;
   }
+  uRight[iL] = uR;
+  depth[iL] = bf / disparity;
+  cost_[iL] = bestCost;
 }
 
 }  // namespace orbis

@@ -105,6 +105,29 @@ TEST(StereoMatcher, RecoversKnownDisparityOnSyntheticPlane) {
   EXPECT_LT(twice.beyond2px, 10);
 }
 
+// The left keypoints split between the caller and the matcher's helper give the serial output,
+// bit for bit, call after call (the helper is kept between calls).
+TEST(StereoMatcher, TwoThreadsGiveTheSerialBits) {
+  for (const std::uint64_t seed : {21u, 22u, 23u}) {
+    const SlantedPlanePair pair = slantedPlane(12.0, 0.012, 0.008, seed);
+    OrbExtractor left, right;
+    std::vector<Keypoint> kl, kr;
+    std::vector<OrbDescriptor> dl, dr;
+    left.extract(pair.left, kl, dl);
+    right.extract(pair.right, kr, dr);
+    ASSERT_GE(kl.size(), StereoMatcher::kMinKeypointsForTwoThreads);
+    const StereoView l{kl, dl, left.pyramid()}, r{kr, dr, right.pyramid()};
+    StereoMatcher serial, parallel;
+    parallel.setParallel(true);
+    std::vector<float> uSerial, dSerial, uParallel, dParallel;
+    serial.match(l, r, left.scaleLevels(), 40.f, 0.1f, uSerial, dSerial);
+    parallel.match(l, r, left.scaleLevels(), 40.f, 0.1f, uParallel, dParallel);
+    EXPECT_GT(std::count_if(uSerial.begin(), uSerial.end(), [](float u) { return u >= 0; }), static_cast<long>(kl.size()) / 3);
+    EXPECT_TRUE(uSerial == uParallel) << "seed " << seed;
+    EXPECT_TRUE(dSerial == dParallel) << "seed " << seed;
+  }
+}
+
 TEST(StereoMatcher, RejectsDisparitiesBeyondTheRange) {
   // Every point has disparity 30 px; with minDepth such that bf/minDepth = 20 px nothing may
   // match, with a generous range almost everything must.

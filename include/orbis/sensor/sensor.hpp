@@ -91,7 +91,9 @@ struct Stereo {
    public:
     // Extractors for the left image and (rightFeaturesFactor times the budget) the right.
     FeatureBuilder(const Camera& camera, const OrbParams& orb)
-        : camera_(camera), left_(orb), right_(rightParams(orb)) {}
+        : camera_(camera), left_(orb), right_(rightParams(orb)) {
+      matcher_.setParallel(true);  // after the two extractions, which ran one per core
+    }
     // The frame's features.
     FrameFeatures build(const Input& in) { return extractStereo(left_, right_, in.left, in.right, camera_, matcher_); }
 
