@@ -51,15 +51,31 @@ void ImagePyramid::allocate(cv::Size size0, const ScaleLevels& levels) {
 }
 
 void ImagePyramid::buildLevel(int l, const cv::Mat& gray8u) {
-  CV_Assert(gray8u.type() == CV_8UC1);
-  const auto i = static_cast<std::size_t>(l);
   if (l == 0) {
-    CV_Assert(gray8u.size() == interior_[0].size());
-    gray8u.copyTo(interior_[0]);
-  } else {
-    cv::resize(interior_[i - 1], interior_[i], interior_[i].size(), 0, 0, cv::INTER_LINEAR);
+    CV_Assert(gray8u.type() == CV_8UC1);
+    setLevel0Rows(gray8u, 0, gray8u.rows);
+    finishLevel0();
+    return;
   }
+  const auto i = static_cast<std::size_t>(l);
+  cv::resize(interior_[i - 1], interior_[i], interior_[i].size(), 0, 0, cv::INTER_LINEAR);
   fillBorder(bordered_[i], kBorder);
 }
+
+void ImagePyramid::setLevel0Rows(const cv::Mat& image, int rowBegin, int rowEnd) {
+  CV_Assert(image.size() == interior_[0].size() && 0 <= rowBegin && rowBegin <= rowEnd && rowEnd <= image.rows);
+  if (rowBegin == rowEnd) return;
+  const cv::Mat source = image.rowRange(rowBegin, rowEnd);
+  cv::Mat target = interior_[0].rowRange(rowBegin, rowEnd);  // a view: written in place
+  switch (image.type()) {
+    case CV_8UC1: source.copyTo(target); break;
+    case CV_8UC3: cv::cvtColor(source, target, cv::COLOR_BGR2GRAY); break;
+    case CV_8UC4: cv::cvtColor(source, target, cv::COLOR_BGRA2GRAY); break;
+    default: CV_Error(cv::Error::StsUnsupportedFormat, "ImagePyramid: expected an 8-bit grey, BGR or BGRA image");
+  }
+  CV_Assert(target.data == interior_[0].ptr(rowBegin));  // not reallocated
+}
+
+void ImagePyramid::finishLevel0() { fillBorder(bordered_[0], kBorder); }
 
 }  // namespace orbis

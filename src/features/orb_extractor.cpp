@@ -399,15 +399,18 @@ void orbBlur(const cv::Mat& src, cv::Mat& dst) {
 
 void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                            std::vector<OrbDescriptor>& descriptors) {
-  const cv::Mat& gray = detail::asGray8u(image, gray_, "OrbExtractor input");
+  const int n = levels();
+  const bool parallel = parallelLevels_ && n > 1;
+  // The parallel path converts a colour image into level 0 on both threads; the serial one here.
+  const cv::Mat& gray = parallel ? detail::checkGrayOrColour8u(image, "OrbExtractor input")
+                                 : detail::asGray8u(image, gray_, "OrbExtractor input");
   keypoints.clear();
   descriptors.clear();
   if (gray.empty()) return;
-  const int n = levels();
   levelKeypoints_.resize(static_cast<std::size_t>(n));
   levelDescriptors_.resize(static_cast<std::size_t>(n));
-  if (parallelLevels_ && n > 1) {
-    extractLevelsInParallel(gray);
+  if (parallel) {
+    extractLevelsInParallel(image);
   } else {
     pyramid_.build(gray, scales_);
     for (int l = 0; l < n; ++l) extractLevel(l, scratch_[0]);
@@ -423,12 +426,15 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
   }
 }
 
-void OrbExtractor::extractLevelsInParallel(const cv::Mat& gray) {
-  // The helper starts on level 0 as soon as it is built, while this thread builds the rest of
-  // the pyramid (each level from the one before); then levels are taken in order by whichever
-  // thread is free. Which thread does a level changes nothing in its output.
+void OrbExtractor::extractLevelsInParallel(const cv::Mat& image) {
+  // Level 0 is converted (or copied) in two halves, one per thread; then the helper starts on
+  // level 0 while this thread builds the rest of the pyramid (each level from the one before);
+  // then levels are taken in order by whichever thread is free. Which thread does a level
+  // changes nothing in its output.
   const int n = levels();
-  pyramid_.allocate(gray.size(), scales_);
+  const int half = image.rows / 2;
+  pyramid_.allocate(image.size(), scales_);
+  std::atomic<int> lowerHalfSet{0};
   std::atomic<int> built{0};  // levels 0 .. built - 1 are ready to read; n + 1: stop, nothing more comes
   std::atomic<int> next{0};
   auto work = [&](LevelScratch& s) {
@@ -440,10 +446,16 @@ void OrbExtractor::extractLevelsInParallel(const cv::Mat& gray) {
     }
   };
   if (!helper_) helper_ = std::make_unique<HelperThread>();
-  pyramid_.buildLevel(0, gray);
-  built.store(1, std::memory_order_release);
   std::exception_ptr helperError;
   helper_->run([&] {
+    try {
+      pyramid_.setLevel0Rows(image, half, image.rows);
+    } catch (...) {
+      helperError = std::current_exception();
+    }
+    lowerHalfSet.store(1, std::memory_order_release);
+    lowerHalfSet.notify_one();
+    if (helperError) return;
     try {
       work(scratch_[1]);
     } catch (...) {
@@ -465,8 +477,14 @@ void OrbExtractor::extractLevelsInParallel(const cv::Mat& gray) {
         }
       }
     } release{built, n + 1};
+    pyramid_.setLevel0Rows(image, 0, half);
+    lowerHalfSet.wait(0, std::memory_order_acquire);
+    if (helperError) return;  // rethrown below, once the helper has returned
+    pyramid_.finishLevel0();
+    built.store(1, std::memory_order_release);
+    built.notify_all();
     for (int l = 1; l < n; ++l) {
-      pyramid_.buildLevel(l, gray);
+      pyramid_.buildLevel(l, image);
       built.store(l + 1, std::memory_order_release);
       built.notify_all();
     }

@@ -62,19 +62,20 @@ class PyramidExtractorBase {
 };
 
 namespace detail {
+// Returns `image` if it is 8-bit grey, BGR or BGRA; throws an Error naming `who` otherwise.
+inline const cv::Mat& checkGrayOrColour8u(const cv::Mat& image, const char* who) {
+  if (image.type() == CV_8UC1 || image.type() == CV_8UC3 || image.type() == CV_8UC4) return image;
+  throw Error(who, "", "expected an 8-bit gray or BGR image, got OpenCV type " + std::to_string(image.type()));
+}
 // Returns `image` if it is already CV_8UC1, else converts a BGR/BGRA image into `scratch`.
 inline const cv::Mat& asGray8u(const cv::Mat& image, cv::Mat& scratch, const char* who) {
-  if (image.type() == CV_8UC1) return image;
+  if (checkGrayOrColour8u(image, who).type() == CV_8UC1) return image;
   if (image.type() == CV_8UC3) {
     cv::cvtColor(image, scratch, cv::COLOR_BGR2GRAY);
     return scratch;
   }
-  if (image.type() == CV_8UC4) {
-    cv::cvtColor(image, scratch, cv::COLOR_BGRA2GRAY);
-    return scratch;
-  }
-  throw Error(who, "", "expected an 8-bit gray or BGR image, got OpenCV type " +
-                           std::to_string(image.type()));
+  cv::cvtColor(image, scratch, cv::COLOR_BGRA2GRAY);
+  return scratch;
 }
 }  // namespace detail
 

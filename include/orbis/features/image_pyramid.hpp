@@ -56,6 +56,13 @@ class ImagePyramid {
   void buildLevel(int l, const cv::Mat& gray8u);
   // @}
   // @{
+  // Level 0 in parts, after allocate(): rows [rowBegin, rowEnd) from an 8-bit grey, BGR or BGRA
+  // image of the allocated size (converted to grey; disjoint row ranges may be set on different
+  // threads), then its border once every row is set.
+  void setLevel0Rows(const cv::Mat& image, int rowBegin, int rowEnd);
+  void finishLevel0();
+  // @}
+  // @{
   // The levels (without border), one level, all of them, and a level's coordinate map.
   int levels() const { return static_cast<int>(interior_.size()); }
   const cv::Mat& level(int l) const { return interior_[static_cast<std::size_t>(l)]; }

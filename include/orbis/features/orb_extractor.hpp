@@ -92,7 +92,7 @@ class OrbExtractor : public PyramidExtractorBase {
     std::vector<int> cellCount, selected, splittable;
   };
 
-  void extractLevelsInParallel(const cv::Mat& gray);
+  void extractLevelsInParallel(const cv::Mat& image);
   void extractLevel(int l, LevelScratch& s);
   void detectCorners(const cv::Mat& level, LevelScratch& s) const;
   static void distribute(LevelScratch& s, int wanted, float minX, float minY, float maxX, float maxY);
