@@ -51,6 +51,7 @@ class HelperThread {
   // Joins the helper when the scope ends, also when the owner's share of the work throws.
   class JoinGuard {
    public:
+    // Joins `helper` when destroyed.
     explicit JoinGuard(HelperThread& helper) : helper_(helper) {}
     JoinGuard(const JoinGuard&) = delete;
     JoinGuard& operator=(const JoinGuard&) = delete;
