@@ -11,8 +11,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <future>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -41,11 +41,13 @@ struct Dataset {
   std::string name;
   int features;
   std::vector<cv::Mat> left, right;  // right empty for monocular sources
-  float bf = 0.f;
   std::vector<cv::Mat> rectifiedLeft = {}, rectifiedRight = {};  // stereo sources only
-  float baseline = 0.f;
   std::vector<cv::Mat> colour = {};  // the left frames as read in colour, where the source is colour (TUM)
+  std::optional<orbis::RectifiedStereoCamera<double>> camera = {};  // the rectified pair's, stereo sources only
 };
+
+float bfOf(const Dataset& d) { return static_cast<float>(d.camera->bf()); }
+float baselineOf(const Dataset& d) { return static_cast<float>(d.camera->baseline); }
 
 std::vector<fs::path> sortedPngs(const fs::path& dir, int count) {
   std::vector<fs::path> files;
@@ -73,12 +75,12 @@ std::vector<Dataset>& datasets() {
   static std::vector<Dataset> sets = [] {
     std::vector<Dataset> out;
     const fs::path root = dataRoot();
-    Dataset tum{"TUM_640x480", 1000, loadGray(root / "tum_fr3_teddy_200/rgb", kFrames), {},
-                0.f, {}, {}, 0.f, loadColour(root / "tum_fr3_teddy_200/rgb", kFrames)};
+    Dataset tum{"TUM_640x480", 1000, loadGray(root / "tum_fr3_teddy_200/rgb", kFrames), {}, {}, {},
+                loadColour(root / "tum_fr3_teddy_200/rgb", kFrames)};
     Dataset euroc{"EuRoC_752x480", 1200, loadGray(root / "euroc_V1_01_easy_95/mav0/cam0/data", kFrames),
                   loadGray(root / "euroc_V1_01_easy_95/mav0/cam1/data", kFrames)};
     Dataset kitti{"KITTI_1226x370", 2000, loadGray(root / "kitti_06_first51/sequences/06/image_0", kFrames),
-                  loadGray(root / "kitti_06_first51/sequences/06/image_1", kFrames), 379.8145f};
+                  loadGray(root / "kitti_06_first51/sequences/06/image_1", kFrames)};
     if (!euroc.left.empty() && euroc.left.size() == euroc.right.size()) {
       // EuRoC is not rectified: rectify the pairs once, outside the timed loops.
       const fs::path cams = root / "euroc_V1_01_easy_95/mav0";
@@ -90,12 +92,12 @@ std::vector<Dataset>& datasets() {
         euroc.rectifiedLeft.push_back(pair.left);
         euroc.rectifiedRight.push_back(pair.right);
       }
-      euroc.bf = static_cast<float>(rect.camera.bf());
-      euroc.baseline = static_cast<float>(rect.camera.baseline);
+      euroc.camera = rect.camera;
     }
     kitti.rectifiedLeft = kitti.left;
     kitti.rectifiedRight = kitti.right;
-    kitti.baseline = 379.8145f / 707.0912f;
+    kitti.camera = orbis::RectifiedStereoCamera<double>(
+        orbis::PinholeCamera<double>{707.0912, 707.0912, 601.8873, 183.1104, 1226, 370}, 379.8145 / 707.0912);
     for (auto* d : {&tum, &euroc, &kitti})
       if (!d->left.empty()) out.push_back(std::move(*d));
     return out;
@@ -165,25 +167,19 @@ void matchOnTwoThreadsWhereOffered(Matcher& matcher) {
   if constexpr (requires { matcher.setParallel(true); }) matcher.setParallel(true);
 }
 
-// A rectified pair as the stereo sensor extracts it (orbis::extractStereo's threads: the right
-// image on a second thread, then the matching, on two threads where the matcher offers it).
-// Wall time.
+// A rectified pair as the stereo sensor extracts it: orbis::extractStereo (the right image on a
+// second thread, then the matching, on two threads where the matcher offers it). Wall time.
 void BM_OrbisStereoTwoThreads(benchmark::State& state, std::size_t which) {
   const Dataset& d = datasets()[which];
   orbis::OrbExtractor left(paramsFor(d)), right(paramsFor(d));
-  std::vector<orbis::Keypoint> kl, kr;
-  std::vector<orbis::OrbDescriptor> dl, dr;
-  std::vector<float> uRight, depth;
   orbis::StereoMatcher matcher;
   matchOnTwoThreadsWhereOffered(matcher);
   std::size_t frame = 0;
   for (auto _ : state) {
     const std::size_t i = frame++ % d.rectifiedLeft.size();
-    auto rightDone = std::async(std::launch::async, [&] { right.extract(d.rectifiedRight[i], kr, dr); });
-    left.extract(d.rectifiedLeft[i], kl, dl);
-    rightDone.get();
-    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), d.bf, d.baseline, uRight, depth);
-    benchmark::DoNotOptimize(uRight.data());
+    const orbis::FrameFeatures f =
+        orbis::extractStereo(left, right, d.rectifiedLeft[i], d.rectifiedRight[i], *d.camera, matcher);
+    benchmark::DoNotOptimize(f.uRight.data());
   }
 }
 
@@ -201,7 +197,7 @@ void BM_OrbisStereo(benchmark::State& state, std::size_t which) {
     const std::size_t i = frame++ % d.rectifiedLeft.size();
     left.extract(d.rectifiedLeft[i], kl, dl);
     right.extract(d.rectifiedRight[i], kr, dr);
-    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), d.bf, d.baseline, uRight, depth);
+    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), bfOf(d), baselineOf(d), uRight, depth);
     matched += static_cast<double>(std::count_if(uRight.begin(), uRight.end(), [](float u) { return u >= 0; }));
     total += static_cast<double>(kl.size());
   }
@@ -209,7 +205,8 @@ void BM_OrbisStereo(benchmark::State& state, std::size_t which) {
 }
 
 // The matching step alone, on features extracted once (what stereo adds to two extractions).
-void BM_OrbisStereoMatchOnly(benchmark::State& state, std::size_t which) {
+// With twoThreads, on the two threads the stereo sensor gives it (wall time).
+void BM_OrbisStereoMatchOnly(benchmark::State& state, std::size_t which, bool twoThreads) {
   const Dataset& d = datasets()[which];
   orbis::OrbExtractor left(paramsFor(d)), right(paramsFor(d));
   std::vector<orbis::Keypoint> kl, kr;
@@ -218,8 +215,9 @@ void BM_OrbisStereoMatchOnly(benchmark::State& state, std::size_t which) {
   right.extract(d.rectifiedRight[0], kr, dr);
   std::vector<float> uRight, depth;
   orbis::StereoMatcher matcher;
+  if (twoThreads) matchOnTwoThreadsWhereOffered(matcher);
   for (auto _ : state) {
-    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), d.bf, d.baseline, uRight, depth);
+    matcher.match({kl, dl, left.pyramid()}, {kr, dr, right.pyramid()}, left.scaleLevels(), bfOf(d), baselineOf(d), uRight, depth);
     benchmark::DoNotOptimize(uRight.data());
   }
 }
@@ -330,7 +328,11 @@ int main(int argc, char** argv) {
     const std::string& n = datasets()[i].name;
     benchmark::RegisterBenchmark(("Stereo/orbis/" + n).c_str(), BM_OrbisStereo, i)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("Stereo/cvORB/" + n).c_str(), BM_CvOrbStereo, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("StereoMatchOnly/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("StereoMatchOnly/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i, false)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("StereoMatchOnlyTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i, true)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
     benchmark::RegisterBenchmark(("StereoTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();

@@ -32,9 +32,11 @@ void ImagePyramid::fillBorder(cv::Mat& bordered, int border) {
   }
 }
 
-void ImagePyramid::build(const cv::Mat& gray8u, const ScaleLevels& levels) {
-  allocate(gray8u.size(), levels);
-  for (int l = 0; l < this->levels(); ++l) buildLevel(l, gray8u);
+void ImagePyramid::build(const cv::Mat& image, const ScaleLevels& levels) {
+  allocate(image.size(), levels);
+  setLevel0Rows(image, 0, image.rows);
+  finishLevel0();
+  for (int l = 1; l < this->levels(); ++l) buildLevel(l);
 }
 
 void ImagePyramid::allocate(cv::Size size0, const ScaleLevels& levels) {
@@ -50,13 +52,8 @@ void ImagePyramid::allocate(cv::Size size0, const ScaleLevels& levels) {
   }
 }
 
-void ImagePyramid::buildLevel(int l, const cv::Mat& gray8u) {
-  if (l == 0) {
-    CV_Assert(gray8u.type() == CV_8UC1);
-    setLevel0Rows(gray8u, 0, gray8u.rows);
-    finishLevel0();
-    return;
-  }
+void ImagePyramid::buildLevel(int l) {
+  CV_Assert(l >= 1 && l < levels());
   const auto i = static_cast<std::size_t>(l);
   cv::resize(interior_[i - 1], interior_[i], interior_[i].size(), 0, 0, cv::INTER_LINEAR);
   fillBorder(bordered_[i], kBorder);

@@ -400,19 +400,16 @@ void orbBlur(const cv::Mat& src, cv::Mat& dst) {
 void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                            std::vector<OrbDescriptor>& descriptors) {
   const int n = levels();
-  const bool parallel = parallelLevels_ && n > 1;
-  // The parallel path converts a colour image into level 0 on both threads; the serial one here.
-  const cv::Mat& gray = parallel ? detail::checkGrayOrColour8u(image, "OrbExtractor input")
-                                 : detail::asGray8u(image, gray_, "OrbExtractor input");
+  detail::checkGrayOrColour8u(image, "OrbExtractor input");
   keypoints.clear();
   descriptors.clear();
-  if (gray.empty()) return;
+  if (image.empty()) return;
   levelKeypoints_.resize(static_cast<std::size_t>(n));
   levelDescriptors_.resize(static_cast<std::size_t>(n));
-  if (parallel) {
+  if (parallelLevels_ && n > 1) {
     extractLevelsInParallel(image);
   } else {
-    pyramid_.build(gray, scales_);
+    pyramid_.build(image, scales_);  // a colour image is converted straight into level 0
     for (int l = 0; l < n; ++l) extractLevel(l, scratch_[0]);
   }
   std::size_t total = 0;
@@ -484,7 +481,7 @@ void OrbExtractor::extractLevelsInParallel(const cv::Mat& image) {
     built.store(1, std::memory_order_release);
     built.notify_all();
     for (int l = 1; l < n; ++l) {
-      pyramid_.buildLevel(l, image);
+      pyramid_.buildLevel(l);
       built.store(l + 1, std::memory_order_release);
       built.notify_all();
     }

@@ -48,8 +48,9 @@ void StereoMatcher::match(const StereoView& left, const StereoView& right, const
   // Each left keypoint's match depends on that keypoint alone, so the two halves can run on two
   // threads; the costs are then gathered in keypoint order, as one thread would.
   cost_.assign(n, -1);
+  const float maxDisparity = bf / minDepth;
   auto matchRange = [&](std::size_t begin, std::size_t end) {
-    for (std::size_t iL = begin; iL < end; ++iL) matchOne(left, right, bf, minDepth, iL, uRight, depth);
+    for (std::size_t iL = begin; iL < end; ++iL) matchOne(left, right, bf, maxDisparity, iL, uRight, depth);
   };
   if (parallel_ && n >= kMinKeypointsForTwoThreads) {
     if (!helper_) helper_ = std::make_unique<HelperThread>();
@@ -119,10 +120,9 @@ int StereoMatcher::bestRightCandidate(const StereoView& left, const StereoView& 
   return bestRight;
 }
 
-void StereoMatcher::matchOne(const StereoView& left, const StereoView& right, float bf, float minDepth, std::size_t iL,
-                             std::vector<float>& uRight, std::vector<float>& depth) {
+void StereoMatcher::matchOne(const StereoView& left, const StereoView& right, float bf, float maxDisparity,
+                             std::size_t iL, std::vector<float>& uRight, std::vector<float>& depth) {
   const float minDisparity = 0.f;
-  const float maxDisparity = bf / minDepth;
   const Keypoint& kl = left.keypoints[iL];
   const int level = kl.octave;
   const int row = static_cast<int>(kl.v);

@@ -52,5 +52,39 @@ TEST(ImagePyramid, LevelMapRoundTripsAndFollowsTheResize) {
   }
 }
 
+// A colour image is converted straight into level 0, in one piece or in row ranges: the levels
+// equal those of the pyramid of cv::cvtColor's grey image, borders included.
+TEST(ImagePyramid, ColourInputEqualsThePyramidOfItsGreyImage) {
+  const ScaleLevels levels(8, 1.2f);
+  cv::Mat bgr(237, 311, CV_8UC3);
+  cv::randu(bgr, cv::Scalar::all(0), cv::Scalar::all(256));
+  cv::Mat bgra, grey;
+  cv::cvtColor(bgr, bgra, cv::COLOR_BGR2BGRA);
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  ImagePyramid reference;
+  reference.build(grey, levels);
+  ImagePyramid whole, fromBgra, inRows;
+  whole.build(bgr, levels);
+  fromBgra.build(bgra, levels);
+  inRows.allocate(bgr.size(), levels);
+  inRows.setLevel0Rows(bgr, 100, bgr.rows);
+  inRows.setLevel0Rows(bgr, 0, 100);
+  inRows.finishLevel0();
+  for (int l = 1; l < levels.levels(); ++l) inRows.buildLevel(l);
+  constexpr int b = ImagePyramid::kBorder;
+  for (int l = 0; l < levels.levels(); ++l) {
+    auto bordered = [&](const ImagePyramid& p) {
+      cv::Mat view = p.level(l);
+      view.adjustROI(b, b, b, b);
+      return view;
+    };
+    const cv::Mat expected = bordered(reference);
+    ASSERT_EQ(expected.size(), cv::Size(reference.level(l).cols + 2 * b, reference.level(l).rows + 2 * b));
+    EXPECT_EQ(cv::norm(expected, bordered(whole), cv::NORM_INF), 0.0) << "BGR, level " << l;
+    EXPECT_EQ(cv::norm(expected, bordered(fromBgra), cv::NORM_INF), 0.0) << "BGRA, level " << l;
+    EXPECT_EQ(cv::norm(expected, bordered(inRows), cv::NORM_INF), 0.0) << "BGR in two row ranges, level " << l;
+  }
+}
+
 }  // namespace
 }  // namespace orbis

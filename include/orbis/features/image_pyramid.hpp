@@ -1,13 +1,14 @@
 // orbis/features/image_pyramid.hpp — a reusable scale pyramid with readable borders.
 //
-// Contract: build() resamples a gray 8-bit image into ScaleLevels::levels() images (level l has
+// Contract: build() converts an 8-bit grey, BGR or BGRA image to grey and resamples it into ScaleLevels::levels() images (level l has
 // size round(W/scale[l]) x round(H/scale[l]), each from the previous by bilinear resize, as
 // ORB-SLAM does). level(l) is a view of the interior; kBorder pixels around it are valid
 // memory filled by reflection (BORDER_REFLECT_101), so patch operations near the image edge
 // (orientation, rotated BRIEF, stereo patch correlation) read defined values. Buffers are kept
-// between calls: rebuilding at the same image size allocates nothing. build() is allocate() then
-// buildLevel(0), buildLevel(1), ... in order; a level may be read on another thread once its
-// buildLevel() has returned (and that return is visible there), while later levels are built.
+// between calls: rebuilding at the same image size allocates nothing. build() is allocate(),
+// setLevel0Rows() over every row, finishLevel0(), then buildLevel(1), buildLevel(2), ... in
+// order; a level may be read on another thread once it is finished (and that is visible there),
+// while later levels are built.
 #pragma once
 
 #include <span>
@@ -47,20 +48,17 @@ class ImagePyramid {
   // Border width, pixels.
   static constexpr int kBorder = 19;
 
-  // Builds every level from an 8-bit grey image.
-  void build(const cv::Mat& gray8u, const ScaleLevels& levels);
+  // Builds every level from an 8-bit grey, BGR or BGRA image (converted straight into level 0).
+  void build(const cv::Mat& image, const ScaleLevels& levels);
   // @{
-  // build() in steps: the buffers for an image of `size`, then level l from the image (l = 0) or
-  // from level l - 1, which must be built already.
+  // build() in steps. allocate(): the buffers for an image of `size`. setLevel0Rows(): rows
+  // [rowBegin, rowEnd) of level 0 from the image (disjoint row ranges may be set on different
+  // threads); finishLevel0(): its border, once every row is set. buildLevel(l), l >= 1: level l
+  // from level l - 1, which must be finished.
   void allocate(cv::Size size, const ScaleLevels& levels);
-  void buildLevel(int l, const cv::Mat& gray8u);
-  // @}
-  // @{
-  // Level 0 in parts, after allocate(): rows [rowBegin, rowEnd) from an 8-bit grey, BGR or BGRA
-  // image of the allocated size (converted to grey; disjoint row ranges may be set on different
-  // threads), then its border once every row is set.
   void setLevel0Rows(const cv::Mat& image, int rowBegin, int rowEnd);
   void finishLevel0();
+  void buildLevel(int l);
   // @}
   // @{
   // The levels (without border), one level, all of them, and a level's coordinate map.

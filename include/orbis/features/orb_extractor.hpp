@@ -100,7 +100,6 @@ class OrbExtractor : public PyramidExtractorBase {
 
   std::vector<int> featuresPerLevel_;
   std::array<CircleRowMask, kHalfPatch + 1> circleRows_{};  // orientation circle, per row offset
-  cv::Mat gray_;
   std::vector<cv::Mat> blurred_;  // per level: sizes differ, so one buffer would reallocate
   std::array<LevelScratch, 2> scratch_;
   std::vector<std::vector<Keypoint>> levelKeypoints_;        // per level, before concatenation

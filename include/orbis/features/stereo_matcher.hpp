@@ -64,7 +64,7 @@ class StereoMatcher {
  private:
   void indexRightRows(const StereoView& right, const ScaleLevels& scales, int rows);
   int bestRightCandidate(const StereoView& left, const StereoView& right, std::size_t iL, float maxDisparity) const;
-  void matchOne(const StereoView& left, const StereoView& right, float bf, float minDepth, std::size_t iL,
+  void matchOne(const StereoView& left, const StereoView& right, float bf, float maxDisparity, std::size_t iL,
                 std::vector<float>& uRight, std::vector<float>& depth);
 
   int rows_ = 0;

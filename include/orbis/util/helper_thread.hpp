@@ -1,5 +1,8 @@
 // orbis/util/helper_thread.hpp — one persistent thread that runs one job at a time: fork-join
 // work on every frame, where starting a thread each time would cost more than waking one.
+// Not parallelFor's pool (util/parallel_for.hpp): that pool is shared with bundle adjustment and
+// runs a caller inline while BA holds it, which in threaded mode is much of the time; a frame's
+// extraction owns its helper.
 //
 // Contract: run(job) hands `job` to the thread and returns at once; join() returns when it has
 // returned. One owner calls run() and join() (not thread-safe); every run() is followed by a
