@@ -1,6 +1,8 @@
 #include "orbis/map/key_frame.hpp"
 
 #include <algorithm>
+#include <functional>
+#include <utility>
 
 namespace orbis {
 
@@ -199,6 +201,26 @@ bool KeyFrame::setBad() {
 
 std::vector<int> KeyFrame::featuresInArea(float u, float v, float r) const {
   return features_->grid.featuresInArea(u, v, r);
+}
+
+std::vector<MapPoint*> distinctGoodPoints(const std::vector<KeyFrame*>& keyFrames) {
+  std::vector<MapPoint*> met;
+  for (const KeyFrame* kf : keyFrames)
+    for (MapPoint* p : kf->points())
+      if (p && !p->isBad()) met.push_back(p);
+  // (point, position met) sorted: the first of each run of one point is its first meeting.
+  std::vector<std::pair<MapPoint*, std::size_t>> byPoint(met.size());
+  for (std::size_t i = 0; i < met.size(); ++i) byPoint[i] = {met[i], i};
+  std::sort(byPoint.begin(), byPoint.end(), [](const auto& a, const auto& b) {
+    return std::less<MapPoint*>{}(a.first, b.first) || (a.first == b.first && a.second < b.second);
+  });
+  std::vector<char> first(met.size(), 0);
+  for (std::size_t k = 0; k < byPoint.size(); ++k)
+    if (k == 0 || byPoint[k].first != byPoint[k - 1].first) first[byPoint[k].second] = 1;
+  std::vector<MapPoint*> out;
+  for (std::size_t i = 0; i < met.size(); ++i)
+    if (first[i]) out.push_back(met[i]);
+  return out;
 }
 
 }  // namespace orbis

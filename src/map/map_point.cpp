@@ -11,26 +11,39 @@ namespace {
 bool isStereoObservation(const KeyFrame* kf, std::size_t index) { return kf->features().uRight[index] >= 0; }
 }  // namespace
 
-bool MapPoint::isObservedBy(const KeyFrame* kf) const {
-  return observations_.count(const_cast<KeyFrame*>(kf)) != 0;
+std::size_t ObservationList::lowerBound(KeyFrameId id) const {
+  return static_cast<std::size_t>(std::lower_bound(ids_.begin(), ids_.end(), id) - ids_.begin());
 }
 
+std::size_t ObservationList::find(KeyFrameId id) const {
+  const std::size_t k = lowerBound(id);
+  return k < ids_.size() && ids_[k] == id ? k : ids_.size();
+}
+
+bool MapPoint::isObservedBy(const KeyFrame* kf) const { return observations_.find(kf->id) != observations_.size(); }
+
 long MapPoint::indexIn(const KeyFrame* kf) const {
-  const auto it = observations_.find(const_cast<KeyFrame*>(kf));
-  return it == observations_.end() ? -1 : static_cast<long>(it->second);
+  const std::size_t k = observations_.find(kf->id);
+  return k == observations_.size() ? -1 : static_cast<long>(observations_.entries_[k].second);
 }
 
 void MapPoint::addObservation(KeyFrame* kf, std::size_t index) {
-  if (!observations_.emplace(kf, index).second) return;
+  const std::size_t k = observations_.lowerBound(kf->id);
+  if (k < observations_.ids_.size() && observations_.ids_[k] == kf->id) return;
+  const auto at = static_cast<std::ptrdiff_t>(k);
+  observations_.entries_.insert(observations_.entries_.begin() + at, {kf, index});
+  observations_.ids_.insert(observations_.ids_.begin() + at, kf->id);
   observationCount_ += isStereoObservation(kf, index) ? 2 : 1;
 }
 
 bool MapPoint::eraseObservation(KeyFrame* kf) {
-  const auto it = observations_.find(kf);
-  if (it == observations_.end()) return false;
-  observationCount_ -= isStereoObservation(kf, it->second) ? 2 : 1;
-  observations_.erase(it);
-  if (reference_ == kf) reference_ = observations_.empty() ? nullptr : observations_.begin()->first;
+  const std::size_t k = observations_.find(kf->id);
+  if (k == observations_.size()) return false;
+  observationCount_ -= isStereoObservation(kf, observations_.entries_[k].second) ? 2 : 1;
+  const auto at = static_cast<std::ptrdiff_t>(k);
+  observations_.entries_.erase(observations_.entries_.begin() + at);
+  observations_.ids_.erase(observations_.ids_.begin() + at);
+  if (reference_ == kf) reference_ = observations_.empty() ? nullptr : observations_.entries_.front().first;
   if (observationCount_ <= 2 && !bad_) {
     setBad();
     return true;
@@ -40,14 +53,15 @@ bool MapPoint::eraseObservation(KeyFrame* kf) {
 
 void MapPoint::setBad() {
   bad_ = true;
-  for (auto& [kf, index] : observations_) kf->erasePoint(index);
-  observations_.clear();
+  for (auto& [kf, index] : observations_.entries_) kf->erasePoint(index);
+  observations_.entries_.clear();
+  observations_.ids_.clear();
   observationCount_ = 0;
 }
 
 void MapPoint::replaceWith(MapPoint* other) {
   if (other == this || other == nullptr) return;
-  for (auto& [kf, index] : observations_) {
+  for (auto& [kf, index] : observations_.entries_) {
     if (!other->isObservedBy(kf)) {
       kf->setPoint(index, other);
       other->addObservation(kf, index);
@@ -58,7 +72,8 @@ void MapPoint::replaceWith(MapPoint* other) {
   other->increaseFound(found_);
   other->increaseVisible(visible_);
   other->computeDistinctiveDescriptor();
-  observations_.clear();
+  observations_.entries_.clear();
+  observations_.ids_.clear();
   observationCount_ = 0;
   bad_ = true;
   replacedBy_ = other;

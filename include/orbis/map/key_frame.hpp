@@ -221,4 +221,10 @@ class KeyFrame {
   bool mapRoot_ = false, gauge_ = false;
 };
 
+// The good (non-null, not bad) map points of `keyFrames`, each once, in the order first met
+// (keyframe by keyframe, keypoint by keypoint): the local point sets of local BA, fusion and loop
+// closing. Deduplicates by sorting pointers rather than through a std::set ordered by id, which
+// dereferenced both points on every comparison. Caller holds Map::mutex().
+std::vector<MapPoint*> distinctGoodPoints(const std::vector<KeyFrame*>& keyFrames);
+
 }  // namespace orbis

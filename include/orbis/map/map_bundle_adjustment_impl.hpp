@@ -99,11 +99,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(const Camera& camera, Map& map,
     std::vector<KeyFrame*> local{kf};
     for (KeyFrame* n : kf->covisibles())
       if (!n->isBad()) local.push_back(n);
-    std::set<MapPoint*, ById> seen;
-    std::vector<MapPoint*> points;
-    for (KeyFrame* k : local)
-      for (MapPoint* p : k->points())
-        if (p && !p->isBad() && seen.insert(p).second) points.push_back(p);
+    const std::vector<MapPoint*> points = distinctGoodPoints(local);
     buildSnapshot(s, local, points, bundleAdjustmentDepthLimit(camera));
     stats.keyFrames = static_cast<int>(local.size());
     stats.fixedKeyFrames = static_cast<int>(s.keyFrames.size() - local.size());

@@ -41,11 +41,12 @@ struct Projection {
   // The matching window's widening by the camera's lens there (searchWindowStretch).
   float windowStretch = 1;
 };
-// Predicts where a map point appears in a frame at pose Tcw; false outside the frustum, the
-// distance range or 60° of the mean direction.
+// Predicts where a map point appears in a frame at pose Tcw (camera centre cameraCentre, i.e.
+// Tcw.inverse().translation(), passed in because callers project hundreds of points from one
+// pose); false outside the frustum, the distance range or 60° of the mean direction.
 template <CameraModel Camera>
 bool projectIntoFrame(const Camera& camera, const MapIntrinsics& bounds, const MapPoint& point, const SE3d& Tcw,
-                      const ScaleLevels& levels, Projection& out);
+                      const Eigen::Vector3d& cameraCentre, const ScaleLevels& levels, Projection& out);
 
 // Motion model: points of the last frame re-projected into the current frame (already posed
 // by the prediction), within `radius` × level scale. Stereo frames also constrain the level by

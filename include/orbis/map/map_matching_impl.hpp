@@ -49,14 +49,14 @@ Eigen::Vector2d noisePixel(const Camera& camera, const Eigen::Vector3d& pc, cons
 
 template <CameraModel Camera>
 bool projectIntoFrame(const Camera& camera, const MapIntrinsics& bounds, const MapPoint& point, const SE3d& Tcw,
-                      const ScaleLevels& levels, Projection& out) {
+                      const Eigen::Vector3d& cameraCentre, const ScaleLevels& levels, Projection& out) {
   const Eigen::Vector3d pw = point.position();
   const Eigen::Vector3d pc = Tcw * pw;
   if (pc.z() <= 0) return false;
   const Eigen::Vector3d obs = detail::projectWithRight(camera, pc);
   const double u = obs.x(), v = obs.y();
   if (!bounds.inImage(u, v)) return false;
-  const Eigen::Vector3d po = pw - Tcw.inverse().translation();
+  const Eigen::Vector3d po = pw - cameraCentre;
   const float dist = static_cast<float>(po.norm());
   if (dist < point.minDistanceInvariance() || dist > point.maxDistanceInvariance()) return false;
   const Eigen::Vector3d& n = point.normal();

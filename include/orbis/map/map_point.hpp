@@ -8,8 +8,9 @@
 // deleted while the map lives; culling marks them bad (and may name a replacement).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
-#include <map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -30,6 +31,35 @@ struct ById {
   // Compares by id.
   template <class T>
   bool operator()(const T* a, const T* b) const { return a->id < b->id; }
+};
+
+// The keyframes observing a map point, each with the index of its keypoint, in keyframe-id
+// order: a sorted vector rather than a std::map, because tracking walks every matched point's
+// observations each frame and a node-based tree made that walk a quarter of the local-map update
+// (docs/notes/2026-11-27-speed-mapping-cpu.md). Read-only outside MapPoint.
+class ObservationList {
+ public:
+  // @{
+  // The (keyframe, keypoint index) pairs in keyframe-id order.
+  using value_type = std::pair<KeyFrame*, std::size_t>;
+  using const_iterator = std::vector<value_type>::const_iterator;
+  const_iterator begin() const { return entries_.begin(); }
+  const_iterator end() const { return entries_.end(); }
+  // @}
+  // @{
+  // Number of observations, and whether there is none.
+  std::size_t size() const { return entries_.size(); }
+  bool empty() const { return entries_.empty(); }
+  // @}
+
+ private:
+  friend class MapPoint;
+  // Position of the entry with keyframe id `id`, or where it would go.
+  std::size_t lowerBound(KeyFrameId id) const;
+  // Index of the entry with keyframe id `id`, or size() when there is none.
+  std::size_t find(KeyFrameId id) const;
+  std::vector<value_type> entries_;
+  std::vector<KeyFrameId> ids_;  // entries_[k].first->id, searched without touching the keyframes
 };
 
 // A 3-D map point: position, observations by keyframes, mean viewing direction, scale-invariance
@@ -59,7 +89,7 @@ class MapPoint {
   KeyFrame* reference() const { return reference_; }
 
   // keyframe -> index of the keypoint in that keyframe.
-  const std::map<KeyFrame*, std::size_t, ById>& observations() const { return observations_; }
+  const ObservationList& observations() const { return observations_; }
   // Observation count as ORB-SLAM counts it: a stereo observation counts twice.
   int observationCount() const { return observationCount_; }
   // Whether kf observes it.
@@ -119,7 +149,7 @@ class MapPoint {
   OrbDescriptor descriptor_;
   float minDistance_ = 0, maxDistance_ = 0;
   KeyFrame* reference_;
-  std::map<KeyFrame*, std::size_t, ById> observations_;
+  ObservationList observations_;
   int observationCount_ = 0;
   int visible_ = 1, found_ = 1;
   bool bad_ = false;

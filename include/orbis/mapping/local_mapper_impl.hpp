@@ -404,12 +404,7 @@ void LocalMapper<Sensor>::fuseWithNeighbours(KeyFrame* kf) {
   const std::vector<MapPoint*> own = kf->goodPoints();
   int fused = 0;
   for (KeyFrame* t : targets) fused += matching::fuse(camera_, *t, own);
-  std::vector<MapPoint*> candidates;
-  std::set<MapPoint*, ById> candidateSet;
-  for (KeyFrame* t : targets)
-    for (MapPoint* p : t->points())
-      if (p && !p->isBad() && candidateSet.insert(p).second) candidates.push_back(p);
-  fused += matching::fuse(camera_, *kf, candidates);
+  fused += matching::fuse(camera_, *kf, distinctGoodPoints(targets));
   note("fused", fused);
   for (MapPoint* p : kf->goodPoints()) {
     p->computeDistinctiveDescriptor();

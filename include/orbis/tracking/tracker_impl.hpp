@@ -441,11 +441,12 @@ int Tracker<Sensor>::searchLocalPoints() {
   }
   std::vector<MapPoint*> candidates;
   std::vector<matching::Projection> projections;
+  const Eigen::Vector3d centre = current_.cameraCenter();
   for (MapPoint* p : localPoints_) {
     if (p->matchedIn == stamp || p->isBad()) continue;
     matching::Projection pr;
-    if (!matching::projectIntoFrame(*current_.camera, current_.intrinsics, *p, current_.Tcw, current_.features->scales,
-                                    pr))
+    if (!matching::projectIntoFrame(*current_.camera, current_.intrinsics, *p, current_.Tcw, centre,
+                                    current_.features->scales, pr))
       continue;
     p->increaseVisible();
     candidates.push_back(p);
