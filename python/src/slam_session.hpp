@@ -24,6 +24,7 @@
 #include "orbis/camera/rectification.hpp"
 #include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/system/slam.hpp"
+#include "orbis/util/allocator.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis::python {
@@ -55,7 +56,9 @@ class SlamSession {
   // rectified), or the fisheye lens of MonocularFisheye.
   SlamSession(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
               const SlamOptions& options, const Lens& lens = {})
-      : camera_(camera), localisationOnly_(options.localisationOnly), slam_(makeSlam(camera, orb, lens, std::move(vocabulary), options)) {}
+      : camera_(camera), localisationOnly_(options.localisationOnly), slam_(makeSlam(camera, orb, lens, std::move(vocabulary), options)) {
+    retainFreedMemory();  // as `orbis run` does (util/allocator.hpp)
+  }
 
   ~SlamSession() {
     if (PyGILState_Check()) {
