@@ -96,6 +96,7 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
     ScopedStage stage(&timer_, "tracking: total");
     result = tracker_->track(std::move(frame));
   }
+  tracker_->handOverNewKeyFrame();
   if (result.state == TrackingState::Lost) ++lost_;
   if (result.state != TrackingState::NotInitialised && !initialisedAtFrame_) initialisedAtFrame_ = frames_ - 1;
   // Deterministic mode: local mapping runs to quiescence after every frame, in order.

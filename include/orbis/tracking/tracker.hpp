@@ -111,8 +111,14 @@ class Tracker {
   Tracker(Map& map, const OrbVocabulary& vocabulary, LocalMappingControl* mapper, TrackerOptions options,
           StageTimer* timer = nullptr);
 
-  // Tracks one frame.
+  // Tracks one frame. A keyframe it makes is handed to local mapping by handOverNewKeyFrame()
+  // (or, failing that, at the start of the next track()).
   TrackResult track(FrameT frame);
+  // Queues the keyframe the last track() made for local mapping; call it after track() returns,
+  // without the map's mutex. Why not inside track(): the queued keyframe wakes the mapping thread,
+  // which the scheduler may run on the tracking thread's core for the keyframe's bag of words
+  // while the pose is still being finished (docs/notes/2026-11-27-speed-mapping-cpu.md).
+  void handOverNewKeyFrame();
 
   // The state after the last frame.
   TrackingState state() const { return state_; }
@@ -204,6 +210,7 @@ class Tracker {
   FrameT current_, last_;
   std::optional<SE3d> velocity_;  // Tcw(current) * Twc(last) of the last tracked pair
   KeyFrame* reference_ = nullptr;
+  KeyFrame* pendingKeyFrame_ = nullptr;  // made by the last track(), not yet queued for mapping
   std::uint64_t lastKeyFrameFrame_ = 0;
   std::optional<std::uint64_t> lastRelocalisedFrame_;
   int matchesInliers_ = 0;

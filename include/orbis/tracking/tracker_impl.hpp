@@ -78,7 +78,16 @@ KeyFrame* Tracker<Sensor>::createKeyFrameFrom(const FrameT& f) {
 }
 
 template <SensorConfiguration Sensor>
+void Tracker<Sensor>::handOverNewKeyFrame() {
+  if (!pendingKeyFrame_) return;
+  mapper_->insertKeyFrame(pendingKeyFrame_);
+  mapper_->setNotStop(false);  // set by createNewKeyFrame
+  pendingKeyFrame_ = nullptr;
+}
+
+template <SensorConfiguration Sensor>
 TrackResult Tracker<Sensor>::track(FrameT frame) {
+  handOverNewKeyFrame();
   std::lock_guard lock(map_.mutex());
   current_ = std::move(frame);
   current_.resetMatches();
@@ -555,10 +564,7 @@ void Tracker<Sensor>::createNewKeyFrame() {
     created += tracking_detail::createPointFromDepth(map_, current_, kf, i) != nullptr;
   note("points_from_depth", created);
   lastKeyFrameFrame_ = current_.index;
-  if (mapper_) {
-    mapper_->insertKeyFrame(kf);
-    mapper_->setNotStop(false);
-  }
+  if (mapper_) pendingKeyFrame_ = kf;  // queued by handOverNewKeyFrame, which also allows stops again
 }
 
 }  // namespace orbis
