@@ -24,7 +24,6 @@
 #include "orbis/camera/rectification.hpp"
 #include "orbis/sensor/monocular_fisheye.hpp"
 #include "orbis/system/slam.hpp"
-#include "orbis/util/allocator.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis::python {
@@ -56,9 +55,7 @@ class SlamSession {
   // rectified), or the fisheye lens of MonocularFisheye.
   SlamSession(const Camera& camera, const OrbParams& orb, std::shared_ptr<const OrbVocabulary> vocabulary,
               const SlamOptions& options, const Lens& lens = {})
-      : camera_(camera), localisationOnly_(options.localisationOnly), slam_(makeSlam(camera, orb, lens, std::move(vocabulary), options)) {
-    retainFreedMemory();  // as `orbis run` does (util/allocator.hpp)
-  }
+      : camera_(camera), localisationOnly_(options.localisationOnly), slam_(makeSlam(camera, orb, lens, std::move(vocabulary), options)) {}
 
   ~SlamSession() {
     if (PyGILState_Check()) {

@@ -11,13 +11,29 @@ namespace {
 bool isStereoObservation(const KeyFrame* kf, std::size_t index) { return kf->features().uRight[index] >= 0; }
 }  // namespace
 
-std::size_t ObservationList::lowerBound(KeyFrameId id) const {
-  return static_cast<std::size_t>(std::lower_bound(ids_.begin(), ids_.end(), id) - ids_.begin());
+std::size_t ObservationList::find(KeyFrameId id) const {
+  const auto it = std::lower_bound(ids_.begin(), ids_.end(), id);
+  return it != ids_.end() && *it == id ? static_cast<std::size_t>(it - ids_.begin()) : ids_.size();
 }
 
-std::size_t ObservationList::find(KeyFrameId id) const {
-  const std::size_t k = lowerBound(id);
-  return k < ids_.size() && ids_[k] == id ? k : ids_.size();
+bool ObservationList::insert(KeyFrame* kf, KeyFrameId id, std::size_t index) {
+  const auto it = std::lower_bound(ids_.begin(), ids_.end(), id);
+  if (it != ids_.end() && *it == id) return false;
+  const auto at = it - ids_.begin();
+  entries_.insert(entries_.begin() + at, {kf, index});
+  ids_.insert(it, id);
+  return true;
+}
+
+void ObservationList::erase(std::size_t k) {
+  const auto at = static_cast<std::ptrdiff_t>(k);
+  entries_.erase(entries_.begin() + at);
+  ids_.erase(ids_.begin() + at);
+}
+
+void ObservationList::clear() {
+  entries_.clear();
+  ids_.clear();
 }
 
 bool MapPoint::isObservedBy(const KeyFrame* kf) const { return observations_.find(kf->id) != observations_.size(); }
@@ -28,22 +44,15 @@ long MapPoint::indexIn(const KeyFrame* kf) const {
 }
 
 void MapPoint::addObservation(KeyFrame* kf, std::size_t index) {
-  const std::size_t k = observations_.lowerBound(kf->id);
-  if (k < observations_.ids_.size() && observations_.ids_[k] == kf->id) return;
-  const auto at = static_cast<std::ptrdiff_t>(k);
-  observations_.entries_.insert(observations_.entries_.begin() + at, {kf, index});
-  observations_.ids_.insert(observations_.ids_.begin() + at, kf->id);
-  observationCount_ += isStereoObservation(kf, index) ? 2 : 1;
+  if (observations_.insert(kf, kf->id, index)) observationCount_ += isStereoObservation(kf, index) ? 2 : 1;
 }
 
 bool MapPoint::eraseObservation(KeyFrame* kf) {
   const std::size_t k = observations_.find(kf->id);
   if (k == observations_.size()) return false;
   observationCount_ -= isStereoObservation(kf, observations_.entries_[k].second) ? 2 : 1;
-  const auto at = static_cast<std::ptrdiff_t>(k);
-  observations_.entries_.erase(observations_.entries_.begin() + at);
-  observations_.ids_.erase(observations_.ids_.begin() + at);
-  if (reference_ == kf) reference_ = observations_.empty() ? nullptr : observations_.entries_.front().first;
+  observations_.erase(k);
+  if (reference_ == kf) reference_ = observations_.empty() ? nullptr : observations_.begin()->first;
   if (observationCount_ <= 2 && !bad_) {
     setBad();
     return true;
@@ -53,15 +62,14 @@ bool MapPoint::eraseObservation(KeyFrame* kf) {
 
 void MapPoint::setBad() {
   bad_ = true;
-  for (auto& [kf, index] : observations_.entries_) kf->erasePoint(index);
-  observations_.entries_.clear();
-  observations_.ids_.clear();
+  for (const auto& [kf, index] : observations_) kf->erasePoint(index);
+  observations_.clear();
   observationCount_ = 0;
 }
 
 void MapPoint::replaceWith(MapPoint* other) {
   if (other == this || other == nullptr) return;
-  for (auto& [kf, index] : observations_.entries_) {
+  for (const auto& [kf, index] : observations_) {
     if (!other->isObservedBy(kf)) {
       kf->setPoint(index, other);
       other->addObservation(kf, index);
@@ -72,8 +80,7 @@ void MapPoint::replaceWith(MapPoint* other) {
   other->increaseFound(found_);
   other->increaseVisible(visible_);
   other->computeDistinctiveDescriptor();
-  observations_.entries_.clear();
-  observations_.ids_.clear();
+  observations_.clear();
   observationCount_ = 0;
   bad_ = true;
   replacedBy_ = other;

@@ -16,7 +16,6 @@
 #include "orbis/io/ply.hpp"
 #include "orbis/io/settings.hpp"
 #include "orbis/sensor/monocular_fisheye.hpp"
-#include "orbis/util/allocator.hpp"
 #include "orbis/util/error.hpp"
 #include "orbis/util/json.hpp"
 #include "orbis/util/progress.hpp"
@@ -521,7 +520,6 @@ class RectifyingSource final : public FrameSource {
 };
 
 RunReport runFrames(FrameSource& rawSource, const RunOptions& options, const Defaults& defaults) {
-  if (options.retainFreedMemory) retainFreedMemory();
   std::unique_ptr<FrameSource> rectifying;
   if (options.settings && rawSource.sensor() == SensorKind::Stereo && !rawSource.hasCalibration()) {
     const Settings s = Settings::load(*options.settings, SensorKind::Stereo);

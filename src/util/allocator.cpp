@@ -1,6 +1,6 @@
 #include "orbis/util/allocator.hpp"
 
-#include <cstdlib>  // defines __GLIBC__ under glibc, which the test below needs
+#include <cstdlib>  // defines __GLIBC__ under glibc, which the #if below tests
 
 #if defined(__GLIBC__)
 #include <malloc.h>

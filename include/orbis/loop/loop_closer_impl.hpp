@@ -282,8 +282,8 @@ bool LoopCloser<Sensor>::computeRelativePose(KeyFrame* kf, const std::vector<Key
   // More matches from the loop keyframe's neighbourhood, seen from the corrected pose.
   std::vector<KeyFrame*> neighbourhood = out.loopKeyFrame->covisibles();
   neighbourhood.insert(neighbourhood.begin(), out.loopKeyFrame);
-  std::erase_if(neighbourhood, [](const KeyFrame* k) { return k->isBad(); });
-  for (MapPoint* p : distinctGoodPoints(neighbourhood)) out.loopPoints.push_back(p);
+  const std::vector<MapPoint*> points = distinctGoodPoints(neighbourhood);
+  out.loopPoints.insert(out.loopPoints.end(), points.begin(), points.end());
   matching::matchByProjection(camera_, *kf, out.correctedTcw, out.loopPoints, out.matches);
   out.matched = static_cast<int>(std::count_if(out.matches.begin(), out.matches.end(), [](MapPoint* p) { return p; }));
   if (out.matched >= options_.minLoopMatches) return true;

@@ -222,8 +222,8 @@ class KeyFrame {
 };
 
 // The good (non-null, not bad) map points of `keyFrames`, each once, in the order first met
-// (keyframe by keyframe, keypoint by keypoint): the local point sets of local BA, fusion and loop
-// closing. Deduplicates by sorting pointers rather than through a std::set ordered by id, which
+// (keyframe by keyframe, keypoint by keypoint; a bad keyframe has none, setBad detaches them):
+// the local point sets of local BA, fusion and loop closing. Deduplicates by sorting pointers rather than through a std::set ordered by id, which
 // dereferenced both points on every comparison. Caller holds Map::mutex().
 std::vector<MapPoint*> distinctGoodPoints(const std::vector<KeyFrame*>& keyFrames);
 

@@ -54,10 +54,13 @@ class ObservationList {
 
  private:
   friend class MapPoint;
-  // Position of the entry with keyframe id `id`, or where it would go.
-  std::size_t lowerBound(KeyFrameId id) const;
-  // Index of the entry with keyframe id `id`, or size() when there is none.
+  // Index of the entry of keyframe id `id`, or size() when there is none.
   std::size_t find(KeyFrameId id) const;
+  // Adds (kf, index) in id order; false when kf already observes.
+  bool insert(KeyFrame* kf, KeyFrameId id, std::size_t index);
+  // Removes entry k (from find).
+  void erase(std::size_t k);
+  void clear();
   std::vector<value_type> entries_;
   std::vector<KeyFrameId> ids_;  // entries_[k].first->id, searched without touching the keyframes
 };

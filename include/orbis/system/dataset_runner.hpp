@@ -71,9 +71,6 @@ struct RunOptions {
   // @}
   int resizeWidth = 0;  // > 0: images and intrinsics scaled to this width first (wins over Camera.newWidth)
   std::function<bool()> stopRequested;  // true: end the run now, outputs written, report interrupted
-  // Keep freed memory in the process for reuse (util/allocator.hpp): bundle adjustment's buffers
-  // are then not faulted in again page by page. Process-wide; false leaves malloc as it was.
-  bool retainFreedMemory = true;
   // Ground truth (any trajectory format readTrajectory detects) for a source that has none, matched
   // to the frames by timestamp (a video run with SourceOptions::timesFile gets the images' times).
   std::optional<std::filesystem::path> groundTruth;

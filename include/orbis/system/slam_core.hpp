@@ -51,6 +51,10 @@ struct SlamOptions {
   // before issue 35). Why: docs/notes/2026-11-26-speed.md, "Monocular mapping at a live pace".
   bool liveWaitForLocalBA = false;
   std::uint32_t seed = 0;         // seeds every random choice (RANSAC)
+  // Keep memory freed by bundle adjustment in the process for reuse (util/allocator.hpp): its
+  // buffers are then not faulted in again page by page. Process-wide, so it stays set after the
+  // system is gone; false leaves malloc's settings alone.
+  bool retainFreedMemory = true;
   // @{
   // The atlas (issue 32; docs/guide/atlas.md): a new map when relocalisation has failed on
   // newMapAfterLostFrames frames that could start one, over newMapAfterLostSeconds; maps merged

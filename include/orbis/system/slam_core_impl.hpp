@@ -8,6 +8,7 @@
 
 #include "orbis/io/map_file.hpp"
 #include "orbis/system/slam_core.hpp"
+#include "orbis/util/allocator.hpp"
 #include "orbis/util/error.hpp"
 
 namespace orbis {
@@ -15,6 +16,7 @@ namespace orbis {
 template <SensorConfiguration Sensor>
 SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabulary> vocabulary, SlamOptions options)
     : camera_(camera), vocabulary_(std::move(vocabulary)), intrinsics_(mapIntrinsicsOf(camera)), options_(options) {
+  if (options_.retainFreedMemory) retainFreedMemory();
   LocalMapperOptions mapperOptions;
   mapperOptions.threaded = !options_.deterministic;
   mapper_ = std::make_unique<LocalMapper<Sensor>>(camera_, map_, mapperOptions, &timer_);

@@ -5,9 +5,9 @@
 // allocates and frees are reused instead of being unmapped and faulted in again page by page; it
 // returns true when both settings took (glibc), false elsewhere (other C libraries: nothing
 // changes). Calling it again does no harm. The cost is that the process keeps its peak heap
-// instead of returning it to the system. runFrames calls it unless RunOptions::retainFreedMemory
-// is false; library users who drive SlamSystem themselves may call it once at start-up. Why:
-// docs/notes/2026-11-27-speed-mapping-cpu.md.
+// instead of returning it to the system. A SLAM system (SlamCore, and so Slam, `orbis run`,
+// bench_slam and the Python classes) calls it on construction unless
+// SlamOptions::retainFreedMemory is false. Why: docs/notes/2026-11-27-speed-mapping-cpu.md.
 #pragma once
 
 namespace orbis {
