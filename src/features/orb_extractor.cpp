@@ -156,6 +156,26 @@ void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDe
   }
 }
 
+// Stores `stop` into `built` when its scope is left by an exception, so that the other thread
+// of an extraction does not wait for a level that will never be built.
+class StopLevelsOnThrow {
+ public:
+  StopLevelsOnThrow(std::atomic<int>& built, int stop) : built_(built), stop_(stop) {}
+  StopLevelsOnThrow(const StopLevelsOnThrow&) = delete;
+  StopLevelsOnThrow& operator=(const StopLevelsOnThrow&) = delete;
+  ~StopLevelsOnThrow() {
+    if (std::uncaught_exceptions() > uncaught_) {
+      built_.store(stop_, std::memory_order_release);
+      built_.notify_all();
+    }
+  }
+
+ private:
+  std::atomic<int>& built_;
+  int stop_;
+  int uncaught_ = std::uncaught_exceptions();
+};
+
 }  // namespace
 
 OrbExtractor::OrbExtractor(const OrbParams& params)
@@ -397,43 +417,142 @@ void orbBlur(const cv::Mat& src, cv::Mat& dst) {
   cv::sepFilter2D(src, dst, CV_8U, taps, taps, cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT_101);
 }
 
-void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
-                           std::vector<OrbDescriptor>& descriptors) {
-  const int n = levels();
+void OrbExtractor::startLevels(const cv::Mat& image, std::vector<Keypoint>& keypoints,
+                               std::vector<OrbDescriptor>& descriptors) {
   detail::checkGrayOrColour8u(image, "OrbExtractor input");
   keypoints.clear();
   descriptors.clear();
-  if (image.empty()) return;
-  levelKeypoints_.resize(static_cast<std::size_t>(n));
-  levelDescriptors_.resize(static_cast<std::size_t>(n));
-  if (parallelLevels_ && n > 1) {
-    extractLevelsInParallel(image);
-  } else {
-    pyramid_.build(image, scales_);  // a colour image is converted straight into level 0
-    for (int l = 0; l < n; ++l) extractLevel(l, scratch_[0]);
-  }
+  levelKeypoints_.resize(static_cast<std::size_t>(levels()));
+  levelDescriptors_.resize(static_cast<std::size_t>(levels()));
+}
+
+void OrbExtractor::collectLevels(std::vector<Keypoint>& keypoints, std::vector<OrbDescriptor>& descriptors) const {
   std::size_t total = 0;
   for (const auto& k : levelKeypoints_) total += k.size();
   keypoints.reserve(total);
   descriptors.reserve(total);
-  for (int l = 0; l < n; ++l) {
+  for (int l = 0; l < levels(); ++l) {
     const auto level = static_cast<std::size_t>(l);
     keypoints.insert(keypoints.end(), levelKeypoints_[level].begin(), levelKeypoints_[level].end());
     descriptors.insert(descriptors.end(), levelDescriptors_[level].begin(), levelDescriptors_[level].end());
   }
 }
 
-void OrbExtractor::extractLevelsInParallel(const cv::Mat& image) {
-  // Level 0 is converted (or copied) in two halves, one per thread; then the helper starts on
-  // level 0 while this thread builds the rest of the pyramid (each level from the one before);
-  // then levels are taken in order by whichever thread is free. Which thread does a level
-  // changes nothing in its output.
+void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
+                           std::vector<OrbDescriptor>& descriptors) {
   const int n = levels();
-  const int half = image.rows / 2;
+  startLevels(image, keypoints, descriptors);
+  if (image.empty()) return;
+  if (parallelLevels_ && n > 1) {
+    extractLevelsInParallel(image);
+  } else {
+    pyramid_.build(image, scales_);  // a colour image is converted straight into level 0
+    for (int l = 0; l < n; ++l) extractLevel(l, scratch_[0]);
+  }
+  collectLevels(keypoints, descriptors);
+}
+
+void OrbExtractor::extractPair(OrbExtractor& first, const cv::Mat& firstImage, std::vector<Keypoint>& firstKeypoints,
+                               std::vector<OrbDescriptor>& firstDescriptors, OrbExtractor& second,
+                               const cv::Mat& secondImage, std::vector<Keypoint>& secondKeypoints,
+                               std::vector<OrbDescriptor>& secondDescriptors) {
+  if (&first == &second || firstImage.empty() || secondImage.empty()) {  // nothing to share
+    first.extract(firstImage, firstKeypoints, firstDescriptors);
+    second.extract(secondImage, secondKeypoints, secondDescriptors);
+    return;
+  }
+  first.startLevels(firstImage, firstKeypoints, firstDescriptors);
+  second.startLevels(secondImage, secondKeypoints, secondDescriptors);
+  OrbExtractor* const extractors[2] = {&first, &second};
+  const cv::Mat* const images[2] = {&firstImage, &secondImage};
+  const int n[2] = {first.levels(), second.levels()};
+  // Level l of the first image, then of the second, l = 0, 1, ...: the largest first, so the
+  // last levels taken are small and the two threads finish close together.
+  std::vector<std::pair<int, int>> tasks;
+  for (int l = 0; l < std::max(n[0], n[1]); ++l)
+    for (int i = 0; i < 2; ++i)
+      if (l < n[i]) tasks.emplace_back(i, l);
+  std::atomic<int> built[2] = {0, 0};  // levels 0 .. built - 1 of each image are ready; n + 1: stop
+  std::atomic<std::size_t> next{0};
+  auto publish = [&](int i, int value) {
+    built[i].store(value, std::memory_order_release);
+    built[i].notify_all();
+  };
+  auto buildPyramid = [&](int i) {
+    ImagePyramid& pyramid = extractors[i]->pyramid_;
+    pyramid.allocate(images[i]->size(), extractors[i]->scales_);
+    pyramid.setLevel0Rows(*images[i], 0, images[i]->rows);
+    pyramid.finishLevel0();
+    publish(i, 1);
+    for (int l = 1; l < n[i]; ++l) {
+      pyramid.buildLevel(l);
+      publish(i, l + 1);
+    }
+  };
+  auto work = [&](int thread) {
+    for (std::size_t t = next++; t < tasks.size(); t = next++) {
+      const auto [i, l] = tasks[t];
+      int ready = built[i].load(std::memory_order_acquire);
+      for (; ready <= l; ready = built[i].load(std::memory_order_acquire)) built[i].wait(ready, std::memory_order_acquire);
+      if (ready > n[i]) return;
+      extractors[i]->extractLevel(l, extractors[i]->scratch_[static_cast<std::size_t>(thread)]);
+    }
+  };
+  if (!first.helper_) first.helper_ = std::make_unique<HelperThread>();
+  std::exception_ptr helperError;
+  first.helper_->run([&] {
+    try {
+      buildPyramid(1);
+      work(1);
+    } catch (...) {
+      helperError = std::current_exception();
+      publish(1, n[1] + 1);  // the caller must not wait for a level that will never be built
+    }
+  });
+  {
+    HelperThread::JoinGuard joinHelper(*first.helper_);
+    // Declared after the join guard so it runs first: a throw here must not leave the helper
+    // waiting for a level of the first image that will never be built.
+    const StopLevelsOnThrow release(built[0], n[0] + 1);
+    buildPyramid(0);
+    work(0);
+  }
+  if (helperError) std::rethrow_exception(helperError);
+  first.collectLevels(firstKeypoints, firstDescriptors);
+  second.collectLevels(secondKeypoints, secondDescriptors);
+}
+
+void OrbExtractor::extractLevelsInParallel(const cv::Mat& image) {
+  // Level 0 is converted (or copied) in row bands that either thread claims; the thread that
+  // completes the last band finishes level 0 and builds the rest of the pyramid (each level from
+  // the one before) while the other starts on level 0; then levels are taken in order by
+  // whichever thread is free. No step waits for a particular thread, so a thread the scheduler
+  // holds back (threaded SLAM's mapping shares the cores) delays only the band or level it holds;
+  // when the helper starts late, the caller converts every band itself. Which thread does a band
+  // or a level changes nothing in the output. Why: docs/notes/2026-11-27-speed-paced-and-pairs.md.
+  constexpr int kBands = 8;
+  const int n = levels();
   pyramid_.allocate(image.size(), scales_);
-  std::atomic<int> lowerHalfSet{0};
+  std::atomic<int> bandsClaimed{0}, bandsDone{0};
   std::atomic<int> built{0};  // levels 0 .. built - 1 are ready to read; n + 1: stop, nothing more comes
   std::atomic<int> next{0};
+  auto publish = [&](int value) {
+    built.store(value, std::memory_order_release);
+    built.notify_all();
+  };
+  // Converts bands while any is unclaimed; the thread that completes the last one builds the pyramid.
+  auto convertAndBuild = [&] {
+    for (int b = bandsClaimed++; b < kBands; b = bandsClaimed++) {
+      pyramid_.setLevel0Rows(image, image.rows * b / kBands, image.rows * (b + 1) / kBands);
+      if (bandsDone.fetch_add(1, std::memory_order_acq_rel) != kBands - 1) continue;
+      pyramid_.finishLevel0();
+      publish(1);
+      for (int l = 1; l < n; ++l) {
+        pyramid_.buildLevel(l);
+        publish(l + 1);
+      }
+    }
+  };
   auto work = [&](LevelScratch& s) {
     for (int l = next++; l < n; l = next++) {
       int ready = built.load(std::memory_order_acquire);
@@ -446,45 +565,19 @@ void OrbExtractor::extractLevelsInParallel(const cv::Mat& image) {
   std::exception_ptr helperError;
   helper_->run([&] {
     try {
-      pyramid_.setLevel0Rows(image, half, image.rows);
-    } catch (...) {
-      helperError = std::current_exception();
-    }
-    lowerHalfSet.store(1, std::memory_order_release);
-    lowerHalfSet.notify_one();
-    if (helperError) return;
-    try {
+      convertAndBuild();
       work(scratch_[1]);
     } catch (...) {
       helperError = std::current_exception();
+      publish(n + 1);  // the caller must not wait for a level this thread will never build
     }
   });
   {
     HelperThread::JoinGuard joinHelper(*helper_);
     // Declared after the join guard so it runs first: a throw below must not leave the helper
     // waiting for a level that will never be built.
-    struct ReleaseOnThrow {
-      std::atomic<int>& built;
-      int stop;
-      int uncaught = std::uncaught_exceptions();
-      ~ReleaseOnThrow() {
-        if (std::uncaught_exceptions() > uncaught) {
-          built.store(stop, std::memory_order_release);
-          built.notify_all();
-        }
-      }
-    } release{built, n + 1};
-    pyramid_.setLevel0Rows(image, 0, half);
-    lowerHalfSet.wait(0, std::memory_order_acquire);
-    if (helperError) return;  // rethrown below, once the helper has returned
-    pyramid_.finishLevel0();
-    built.store(1, std::memory_order_release);
-    built.notify_all();
-    for (int l = 1; l < n; ++l) {
-      pyramid_.buildLevel(l);
-      built.store(l + 1, std::memory_order_release);
-      built.notify_all();
-    }
+    const StopLevelsOnThrow release(built, n + 1);
+    convertAndBuild();
     work(scratch_[0]);
   }
   if (helperError) std::rethrow_exception(helperError);

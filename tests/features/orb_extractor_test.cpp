@@ -194,6 +194,46 @@ TEST(OrbExtractor, ParallelLevelsGiveTheSerialBits) {
   }
 }
 
+// A stereo pair extracted together (both threads take both images' levels) gives each
+// extractor's own extract() bits: different sizes, budgets (the right one larger, as with
+// rightFeaturesFactor), grey and colour, frame after frame, and an empty second image.
+TEST(OrbExtractor, PairGivesEachExtractorsOwnBits) {
+  OrbParams leftParams, rightParams;
+  leftParams.features = 1000;
+  rightParams.features = 3000;
+  OrbExtractor leftAlone(leftParams), rightAlone(rightParams), left(leftParams), right(rightParams);
+  const cv::Size sizes[] = {{640, 480}, {1241, 376}, {1241, 376}, {320, 240}};
+  std::uint64_t seed = 11;
+  auto expectSame = [](const std::vector<Keypoint>& a, const std::vector<OrbDescriptor>& da,
+                       const std::vector<Keypoint>& b, const std::vector<OrbDescriptor>& db, const cv::Size& size) {
+    ASSERT_EQ(a.size(), b.size()) << size;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE(a[i].u == b[i].u && a[i].v == b[i].v && a[i].angle == b[i].angle &&
+                  a[i].response == b[i].response && a[i].octave == b[i].octave)
+          << size << " keypoint " << i;
+    EXPECT_TRUE(da == db) << size;
+  };
+  for (const cv::Size& size : sizes) {
+    cv::Mat leftImage = test::texturedImage(size.width, size.height, seed++);
+    cv::Mat rightImage = test::texturedImage(size.width, size.height, seed++);
+    if (seed % 4 == 1) cv::cvtColor(leftImage, leftImage, cv::COLOR_GRAY2BGR);
+    std::vector<Keypoint> kl, kr, pl, pr;
+    std::vector<OrbDescriptor> dl, dr, ql, qr;
+    leftAlone.extract(leftImage, kl, dl);
+    rightAlone.extract(rightImage, kr, dr);
+    OrbExtractor::extractPair(left, leftImage, pl, ql, right, rightImage, pr, qr);
+    ASSERT_GT(kl.size(), 500u) << size;
+    ASSERT_GT(kr.size(), kl.size()) << size;
+    expectSame(kl, dl, pl, ql, size);
+    expectSame(kr, dr, pr, qr, size);
+  }
+  std::vector<Keypoint> pl, pr;
+  std::vector<OrbDescriptor> ql, qr;
+  OrbExtractor::extractPair(left, test::texturedImage(320, 240, 1), pl, ql, right, cv::Mat(), pr, qr);
+  EXPECT_GT(pl.size(), 100u);
+  EXPECT_TRUE(pr.empty() && qr.empty());
+}
+
 // Share of 32x32 cells with a keypoint: the quadtree must spread better than cv::ORB's
 // strongest-first selection.
 double coverage(const std::vector<Keypoint>& kps, cv::Size size) {

@@ -8,8 +8,8 @@
 // kind(i) is Monocular without depth, Close when depth < closeDepth (camera's threshold, 40
 // baselines by default), else Far. The grid indexes keypointsUn over the undistorted image
 // bounds (the undistorted image corners for a distorting lens, the image rectangle otherwise).
-// Builders: extractMonocular, extractStereo (rectified pair; the right image is extracted on a
-// second thread), extractRgbd (depth image CV_16U or CV_32F, raw value / depthScale =
+// Builders: extractMonocular, extractStereo (rectified pair extracted on two threads: the
+// extractor's extractPair when it has one, else the right image on a second thread), extractRgbd (depth image CV_16U or CV_32F, raw value / depthScale =
 // metres; 0, negative or NaN means no depth). Errors of input type throw orbis::Error.
 #pragma once
 
@@ -100,13 +100,22 @@ FrameFeatures extractStereo(E& leftExtractor, E& rightExtractor, const cv::Mat& 
   FrameFeatures f;
   std::vector<Keypoint> rightKeypoints;
   std::vector<OrbDescriptor> rightDescriptors;
-  // The right image on a thread of its own, the left on the caller's. std::async rather than
-  // cv::parallel_for_: OpenCV's pool synchronises in uninstrumented code, which ThreadSanitizer
-  // cannot see, and one extra thread per frame costs tens of microseconds against milliseconds.
-  auto right = std::async(std::launch::async,
-                          [&] { rightExtractor.extract(rightImage, rightKeypoints, rightDescriptors); });
-  leftExtractor.extract(leftImage, f.keypoints, f.descriptors);
-  right.get();
+  if constexpr (requires {
+                  E::extractPair(leftExtractor, leftImage, f.keypoints, f.descriptors, rightExtractor, rightImage,
+                                 rightKeypoints, rightDescriptors);
+                }) {
+    // Both images' levels shared by two threads as they come free (OrbExtractor::extractPair).
+    E::extractPair(leftExtractor, leftImage, f.keypoints, f.descriptors, rightExtractor, rightImage, rightKeypoints,
+                   rightDescriptors);
+  } else {
+    // The right image on a thread of its own, the left on the caller's. std::async rather than
+    // cv::parallel_for_: OpenCV's pool synchronises in uninstrumented code, which ThreadSanitizer
+    // cannot see, and one extra thread per frame costs tens of microseconds against milliseconds.
+    auto right = std::async(std::launch::async,
+                            [&] { rightExtractor.extract(rightImage, rightKeypoints, rightDescriptors); });
+    leftExtractor.extract(leftImage, f.keypoints, f.descriptors);
+    right.get();
+  }
   f.scales = leftExtractor.scaleLevels();
   f.closeDepth = static_cast<float>(camera.closeDepthThreshold());
   detail::finishMonocular(f, camera.pinhole, {}, leftImage.cols, leftImage.rows);

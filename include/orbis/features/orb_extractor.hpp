@@ -12,10 +12,14 @@
 // and falls short on images with too few corners.
 // Deterministic; not thread-safe (one extractor per image stream: buffers are reused). With
 // setParallelLevels(true) the levels are shared between the caller's thread and a helper kept by
-// the extractor, which starts on level 0 while the caller builds the rest of the pyramid (each
-// level's corners, quadtree and descriptors depend on that level alone, so the output is
+// the extractor: either thread converts bands of level 0, the one that completes it builds the
+// rest of the pyramid while the other starts on level 0, and the levels go to whichever is free
+// (each level's corners, quadtree and descriptors depend on that level alone, so the output is
 // bit-identical to the serial one); for an extractor that runs alone on a frame (monocular,
-// RGB-D), not one of a stereo pair that already runs on two threads.
+// RGB-D). A stereo pair goes through extractPair: each thread builds one image's pyramid, then
+// both take the levels of both images, largest first, as they come free, so that a thread the
+// scheduler holds back (mapping shares the cores) delays a level, not a whole image; the output
+// is bit-identical to extract() on each image.
 #pragma once
 
 #include <array>
@@ -68,6 +72,13 @@ class OrbExtractor : public PyramidExtractorBase {
   void extract(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                std::vector<OrbDescriptor>& descriptors);
 
+  // extract() of two images by two extractors (a stereo pair), on the caller's thread and
+  // first's helper thread; each output is bit-identical to that extractor's extract().
+  static void extractPair(OrbExtractor& first, const cv::Mat& firstImage, std::vector<Keypoint>& firstKeypoints,
+                          std::vector<OrbDescriptor>& firstDescriptors, OrbExtractor& second,
+                          const cv::Mat& secondImage, std::vector<Keypoint>& secondKeypoints,
+                          std::vector<OrbDescriptor>& secondDescriptors);
+
   // Keypoints wanted on each level (sums to params().features).
   std::span<const int> featuresPerLevel() const { return featuresPerLevel_; }
   // Extract one image's pyramid levels on two threads (the same keypoints and descriptors either way).
@@ -93,6 +104,8 @@ class OrbExtractor : public PyramidExtractorBase {
   };
 
   void extractLevelsInParallel(const cv::Mat& image);
+  void startLevels(const cv::Mat& image, std::vector<Keypoint>& keypoints, std::vector<OrbDescriptor>& descriptors);
+  void collectLevels(std::vector<Keypoint>& keypoints, std::vector<OrbDescriptor>& descriptors) const;
   void extractLevel(int l, LevelScratch& s);
   void detectCorners(const cv::Mat& level, LevelScratch& s) const;
   static void distribute(LevelScratch& s, int wanted, float minX, float minY, float maxX, float maxY);
