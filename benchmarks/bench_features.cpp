@@ -2,11 +2,14 @@
 // feature budget in the same run. After the Google Benchmark table, prints the time ratio
 // ours / cv::ORB and the coverage (share of 32x32 px cells holding >= 1 keypoint) per dataset.
 // One thread each (CPU time), and orbis as the SLAM sensors run it (two threads, wall time, the
-// TUM frames in colour) against cv::ORB's one thread.
+// TUM frames in colour) against cv::ORB's one thread; the same again while background threads
+// keep the cores busy (the ...Loaded rows: threaded SLAM's mapping competes with extraction for
+// the two cores, and how the work is split decides how much a held-back thread delays a frame).
 // Data: ORBIS_DATA or ../shared/datasets; a dataset that is absent is skipped.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +18,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <opencv2/features2d.hpp>
@@ -145,10 +149,34 @@ void BM_CvOrbExtract(benchmark::State& state, std::size_t which) {
   state.counters["keypoints"] = static_cast<double>(total) / static_cast<double>(state.iterations());
 }
 
+// Threads that keep cores busy while they live (arithmetic only, at the caller's priority), like
+// local mapping's threads during a threaded run.
+class BackgroundLoad {
+ public:
+  explicit BackgroundLoad(int threads) {
+    for (int t = 0; t < threads; ++t)
+      threads_.emplace_back([this] {
+        double x = 1.0;
+        while (!stop_.load(std::memory_order_relaxed))
+          for (int i = 0; i < 1000; ++i) x = x * 1.0000001 + 1e-9;
+        benchmark::DoNotOptimize(x);
+      });
+  }
+  ~BackgroundLoad() {
+    stop_ = true;
+    for (std::thread& t : threads_) t.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::vector<std::thread> threads_;
+};
+
 // One image as the monocular and RGB-D sensors extract it: the levels on two threads, a colour
 // image (where the source has one) converted inside. Wall time.
-void BM_OrbisExtractTwoThreads(benchmark::State& state, std::size_t which) {
+void BM_OrbisExtractTwoThreads(benchmark::State& state, std::size_t which, int loadThreads) {
   const Dataset& d = datasets()[which];
+  BackgroundLoad load(loadThreads);
   const std::vector<cv::Mat>& frames = d.colour.empty() ? d.left : d.colour;
   orbis::OrbExtractor extractor(paramsFor(d));
   extractor.setParallelLevels(true);
@@ -169,8 +197,9 @@ void matchOnTwoThreadsWhereOffered(Matcher& matcher) {
 
 // A rectified pair as the stereo sensor extracts it: orbis::extractStereo (the right image on a
 // second thread, then the matching, on two threads where the matcher offers it). Wall time.
-void BM_OrbisStereoTwoThreads(benchmark::State& state, std::size_t which) {
+void BM_OrbisStereoTwoThreads(benchmark::State& state, std::size_t which, int loadThreads) {
   const Dataset& d = datasets()[which];
+  BackgroundLoad load(loadThreads);
   orbis::OrbExtractor left(paramsFor(d)), right(paramsFor(d));
   orbis::StereoMatcher matcher;
   matchOnTwoThreadsWhereOffered(matcher);
@@ -319,7 +348,10 @@ int main(int argc, char** argv) {
     const std::string& n = datasets()[i].name;
     benchmark::RegisterBenchmark(("Extract/orbis/" + n).c_str(), BM_OrbisExtract, i)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("Extract/cvORB/" + n).c_str(), BM_CvOrbExtract, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("ExtractTwoThreads/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i)
+    benchmark::RegisterBenchmark(("ExtractTwoThreads/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, 0)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(("ExtractTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, 2)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }
@@ -333,7 +365,10 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("StereoMatchOnlyTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i, true)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("StereoTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i)
+    benchmark::RegisterBenchmark(("StereoTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, 0)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(("StereoTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, 2)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }
@@ -358,6 +393,15 @@ int main(int argc, char** argv) {
     const auto h = reporter.wallTimes.find("StereoTwoThreads/orbis/" + d.name);
     if (h != reporter.wallTimes.end() && g != reporter.wallTimes.end())
       std::printf("%-16s stereo pair as SLAM runs it (two threads, wall) %.3f\n", d.name.c_str(), h->second / g->second);
+    // Under load: the wall time against the same rows without it (how much a busy machine costs).
+    const auto fl = reporter.wallTimes.find("ExtractTwoThreadsLoaded/orbis/" + d.name);
+    if (fl != reporter.wallTimes.end() && f != reporter.wallTimes.end())
+      std::printf("%-16s extraction as SLAM runs it, two busy threads beside / idle (wall) %.3f\n", d.name.c_str(),
+                  fl->second / f->second);
+    const auto hl = reporter.wallTimes.find("StereoTwoThreadsLoaded/orbis/" + d.name);
+    if (hl != reporter.wallTimes.end() && h != reporter.wallTimes.end())
+      std::printf("%-16s stereo pair as SLAM runs it, two busy threads beside / idle (wall) %.3f\n", d.name.c_str(),
+                  hl->second / h->second);
   }
   printCoverage();
   benchmark::Shutdown();

@@ -10,9 +10,12 @@
 // The last column divides by ORB-SLAM2's median tracking time measured in an earlier session on
 // this machine (issue 35): a fixed external figure, not re-measured here, so it moves with the
 // machine's load while the cv::ORB ratio does not.
-// --realtime adds live-camera runs (frames fed at their timestamps, SlamOptions::liveCamera) of
-// the monocular cases: the wait for mapping after a keyframe (median, p95), keyframes, local BA
-// time, and the Sim(3)-aligned ATE and scale (estimate to ground truth).
+// --realtime adds runs of every case paced at the frames' timestamps (RunOptions::realtime), as
+// ORB-SLAM2's example programs feed them (they sleep until the next timestamp), and prints the
+// per-frame time as those programs measure it: the whole tracking call (Slam::track, from the
+// frame fed to its pose), median and p95. For the monocular cases it adds the live-camera
+// figures (SlamOptions::liveCamera): the wait for mapping after a keyframe (median, p95),
+// keyframes, local BA time, and the Sim(3)-aligned ATE and scale (estimate to ground truth).
 // Data: --data DIR, else ORBIS_DATA, else ../shared/datasets; an absent slice is skipped.
 // Usage and options: docs/guide/speed.md.
 #include <algorithm>
@@ -127,6 +130,7 @@ struct CaseResult {
   std::vector<std::string> stageOrder;
   std::map<std::string, StageRuns> stages;
   std::vector<double> keyFrames, ateMm, scale, seconds;
+  std::vector<double> callMedian, callP95;  // the whole tracking call (paced runs only)
   std::size_t frames = 0;
 };
 
@@ -140,6 +144,8 @@ void addReport(CaseResult& result, const RunReport& report, const fs::path& out,
   }
   result.keyFrames.push_back(static_cast<double>(report.stats.keyFrames));
   result.seconds.push_back(report.seconds);
+  result.callMedian.push_back(report.latency.medianMs);
+  result.callP95.push_back(report.latency.p95Ms);
   result.frames = report.stats.frames;
   if (report.ateRmse) result.ateMm.push_back(*report.ateRmse * 1000);
   // The similarity that aligns the estimate to the ground truth: its scale is the map's unit in
@@ -248,8 +254,9 @@ void usage() {
       "  --only LABEL        only cases whose label contains LABEL (repeatable), e.g. mono, kitti06\n"
       "  --sequence SPEC     add a sequence: KIND (tum, euroc, kitti) : PATH [: mono|stereo|rgbd]; its\n"
       "                      settings.yaml (settings_mono.yaml for mono) is used when present\n"
-      "  --realtime          also run the monocular cases as a live camera: wait for mapping, local BA, ATE, scale\n"
-      "  --realtime-only     only the live-camera runs\n"
+      "  --realtime          also run every case paced at its timestamps (as ORB-SLAM2's examples): per-frame\n"
+      "                      time of the whole tracking call; for monocular also wait for mapping, local BA, ATE, scale\n"
+      "  --realtime-only     only the paced runs\n"
       "  --data DIR          the shared datasets (default $ORBIS_DATA, else ../shared/datasets)\n"
       "  --work DIR          scratch folder for the runs' outputs (default: the temp folder)\n");
 }
@@ -313,11 +320,10 @@ int main(int argc, char** argv) try {
       printStages(c, rows.back().r, false);
     }
   if (options.realtime)
-    for (const Case& c : cases)
-      if (c.sensor == SensorKind::Monocular) {
-        live.push_back({c, runCase(c, options, true)});
-        printStages(c, live.back().r, true);
-      }
+    for (const Case& c : cases) {
+      live.push_back({c, runCase(c, options, true)});
+      printStages(c, live.back().r, true);
+    }
 
   if (!rows.empty()) {
     std::printf("\nper-frame time, threaded (ORB extraction + tracking medians, as issue 35), median over %d runs\n",
@@ -337,10 +343,25 @@ int main(int argc, char** argv) try {
     std::printf("* ORB-SLAM2's medians from issue 35 (an earlier session, same machine class), not re-measured.\n");
   }
   if (!live.empty()) {
-    std::printf("\nlive camera (--realtime), median over %d runs\n", options.runs);
+    std::printf("\nper-frame time, paced at the timestamps (--realtime, as ORB-SLAM2's example programs run): the\n"
+                "whole tracking call (frame fed to pose: extraction, tracking, any wait), median over %d runs\n",
+                options.runs);
+    std::printf("%-18s %8s %9s %9s %9s %9s %10s %12s\n", "case", "cv::ORB", "extract", "track", "call", "call p95",
+                "/ cv::ORB", "/ ORB-SLAM2*");
+    for (const auto& [c, r] : live) {
+      const double cv = median(r.cvOrbMedian), call = median(r.callMedian);
+      char external[16] = "-";
+      if (c.orbSlam2Ms > 0) std::snprintf(external, sizeof external, "%.2f", call / c.orbSlam2Ms);
+      std::printf("%-18s %8.2f %9.2f %9.2f %9.2f %9.2f %10.3f %12s\n", c.label.c_str(), cv,
+                  stageMedian(r, "tracking: ORB extraction"), stageMedian(r, "tracking: total"), call,
+                  median(r.callP95), cv > 0 ? call / cv : 0, external);
+    }
+    std::printf("* ORB-SLAM2's medians from issue 35 (an earlier session, same machine class), not re-measured.\n");
+    std::printf("\nlive camera (--realtime), monocular, median over %d runs\n", options.runs);
     std::printf("%-18s %5s %11s %9s %9s %11s %9s %8s\n", "case", "KFs", "wait med", "wait p95", "local BA",
                 "local BA p95", "ATE mm", "scale");
     for (const auto& [c, r] : live) {
+      if (c.sensor != SensorKind::Monocular) continue;
       std::printf("%-18s %5.0f %11.2f %9.2f %9.2f %11.2f %9.1f %8.4f\n", c.label.c_str(), median(r.keyFrames),
                   stageMedian(r, "tracking: wait for mapping"), stageP95(r, "tracking: wait for mapping"),
                   stageMedian(r, "mapping: local BA"), stageP95(r, "mapping: local BA"), median(r.ateMm),
