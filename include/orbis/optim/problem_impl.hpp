@@ -333,13 +333,11 @@ void Problem<PoseM, Terms...>::schurComplement(double mu, Eigen::VectorXd& rhs) 
         for (int b = a; b < last; ++b, ++k) {
           if (pairOwner_[k] != owner) continue;
           // lazyProduct: Eigen would otherwise send these small fixed-size products to GEMM.
-          // Subtracted, not negated and added: the same bits (x + (-p) == x - p) without the
-          // negated copy.
-          const PoseBlock block = y.lazyProduct(cross_[b].transpose());
+          const PoseBlock block = -y.lazyProduct(cross_[b].transpose());
           if (a == b) {
-            system_.template subtractDiagonal<D>(links_[a].pose, block);
+            system_.template addDiagonal<D>(links_[a].pose, block);
           } else {
-            system_.template subtractSymmetrised<D>(pairSlots_[k], links_[a].pose == links_[b].pose, block);
+            system_.template addSymmetrised<D>(pairSlots_[k], links_[a].pose == links_[b].pose, block);
           }
         }
       }

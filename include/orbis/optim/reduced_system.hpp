@@ -89,37 +89,18 @@ class ReducedCameraSystem {
       for (int r = 0; r <= c; ++r) col[r] += block(r, c);
     }
   }
-  // @{
-  // addDiagonal and addOffDiagonal of −B, and for a cross term between two entries of the same
-  // block −B (i < j) or the upper triangle of −(B + Bᵀ) (i == j), as subtractions: the same bits
-  // as adding the negated block, since negation is exact, without forming it.
+  // Adds B (i < j) or the upper triangle of B + Bᵀ (i == j): the symmetric contribution of a
+  // cross term between two entries of the same block.
   template <int D, class Derived>
-  void subtractDiagonal(int j, const Eigen::MatrixBase<Derived>& block) {
-    const int* starts = colStarts_.data() + j * D;
-    const int offset = static_cast<int>(rowsAbove_[j].size()) * D;
-    for (int c = 0; c < D; ++c) {
-      double* col = values_.data() + starts[c] + offset;
-      for (int r = 0; r <= c; ++r) col[r] -= block(r, c);
-    }
-  }
-  template <int D, class Derived>
-  void subtractOffDiagonal(BlockSlot s, const Eigen::MatrixBase<Derived>& block) {
-    const int* starts = colStarts_.data() + s.column * D;
-    for (int c = 0; c < D; ++c) {
-      Eigen::Map<Eigen::Matrix<double, D, 1>>(values_.data() + starts[c] + s.position * D) -= block.col(c);
-    }
-  }
-  template <int D, class Derived>
-  void subtractSymmetrised(BlockSlot s, bool diagonal, const Eigen::MatrixBase<Derived>& block) {
-    if (!diagonal) { subtractOffDiagonal<D>(s, block); return; }
+  void addSymmetrised(BlockSlot s, bool diagonal, const Eigen::MatrixBase<Derived>& block) {
+    if (!diagonal) { addOffDiagonal<D>(s, block); return; }
     const int* starts = colStarts_.data() + s.column * D;
     const int offset = s.position * D;
     for (int c = 0; c < D; ++c) {
       double* col = values_.data() + starts[c] + offset;
-      for (int r = 0; r <= c; ++r) col[r] -= block(r, c) + block(c, r);
+      for (int r = 0; r <= c; ++r) col[r] += block(r, c) + block(c, r);
     }
   }
-  // @}
 
   // Factorises the current values and solves S·x = rhs. False when not positive definite.
   bool solve(std::span<const double> rhs, std::span<double> x);
