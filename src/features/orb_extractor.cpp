@@ -156,26 +156,6 @@ void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDe
   }
 }
 
-// Stores `stop` into `built` when its scope is left by an exception, so that the other thread
-// of an extraction does not wait for a level that will never be built.
-class StopLevelsOnThrow {
- public:
-  StopLevelsOnThrow(std::atomic<int>& built, int stop) : built_(built), stop_(stop) {}
-  StopLevelsOnThrow(const StopLevelsOnThrow&) = delete;
-  StopLevelsOnThrow& operator=(const StopLevelsOnThrow&) = delete;
-  ~StopLevelsOnThrow() {
-    if (std::uncaught_exceptions() > uncaught_) {
-      built_.store(stop_, std::memory_order_release);
-      built_.notify_all();
-    }
-  }
-
- private:
-  std::atomic<int>& built_;
-  int stop_;
-  int uncaught_ = std::uncaught_exceptions();
-};
-
 }  // namespace
 
 OrbExtractor::OrbExtractor(const OrbParams& params)
@@ -444,7 +424,9 @@ void OrbExtractor::extract(const cv::Mat& image, std::vector<Keypoint>& keypoint
   startLevels(image, keypoints, descriptors);
   if (image.empty()) return;
   if (parallelLevels_ && n > 1) {
-    extractLevelsInParallel(image);
+    OrbExtractor* const self[] = {this};
+    const cv::Mat* const imageOf[] = {&image};
+    extractOnTwoThreads(self, imageOf, *this);
   } else {
     pyramid_.build(image, scales_);  // a colour image is converted straight into level 0
     for (int l = 0; l < n; ++l) extractLevel(l, scratch_[0]);
@@ -463,122 +445,94 @@ void OrbExtractor::extractPair(OrbExtractor& first, const cv::Mat& firstImage, s
   }
   first.startLevels(firstImage, firstKeypoints, firstDescriptors);
   second.startLevels(secondImage, secondKeypoints, secondDescriptors);
-  OrbExtractor* const extractors[2] = {&first, &second};
-  const cv::Mat* const images[2] = {&firstImage, &secondImage};
-  const int n[2] = {first.levels(), second.levels()};
-  // Level l of the first image, then of the second, l = 0, 1, ...: the largest first, so the
-  // last levels taken are small and the two threads finish close together.
-  std::vector<std::pair<int, int>> tasks;
-  for (int l = 0; l < std::max(n[0], n[1]); ++l)
-    for (int i = 0; i < 2; ++i)
-      if (l < n[i]) tasks.emplace_back(i, l);
-  std::atomic<int> built[2] = {0, 0};  // levels 0 .. built - 1 of each image are ready; n + 1: stop
-  std::atomic<std::size_t> next{0};
-  auto publish = [&](int i, int value) {
-    built[i].store(value, std::memory_order_release);
-    built[i].notify_all();
-  };
-  auto buildPyramid = [&](int i) {
-    ImagePyramid& pyramid = extractors[i]->pyramid_;
-    pyramid.allocate(images[i]->size(), extractors[i]->scales_);
-    pyramid.setLevel0Rows(*images[i], 0, images[i]->rows);
-    pyramid.finishLevel0();
-    publish(i, 1);
-    for (int l = 1; l < n[i]; ++l) {
-      pyramid.buildLevel(l);
-      publish(i, l + 1);
-    }
-  };
-  auto work = [&](int thread) {
-    for (std::size_t t = next++; t < tasks.size(); t = next++) {
-      const auto [i, l] = tasks[t];
-      int ready = built[i].load(std::memory_order_acquire);
-      for (; ready <= l; ready = built[i].load(std::memory_order_acquire)) built[i].wait(ready, std::memory_order_acquire);
-      if (ready > n[i]) return;
-      extractors[i]->extractLevel(l, extractors[i]->scratch_[static_cast<std::size_t>(thread)]);
-    }
-  };
-  if (!first.helper_) first.helper_ = std::make_unique<HelperThread>();
-  std::exception_ptr helperError;
-  first.helper_->run([&] {
-    try {
-      buildPyramid(1);
-      work(1);
-    } catch (...) {
-      helperError = std::current_exception();
-      publish(1, n[1] + 1);  // the caller must not wait for a level that will never be built
-    }
-  });
-  {
-    HelperThread::JoinGuard joinHelper(*first.helper_);
-    // Declared after the join guard so it runs first: a throw here must not leave the helper
-    // waiting for a level of the first image that will never be built.
-    const StopLevelsOnThrow release(built[0], n[0] + 1);
-    buildPyramid(0);
-    work(0);
-  }
-  if (helperError) std::rethrow_exception(helperError);
+  OrbExtractor* const extractors[] = {&first, &second};
+  const cv::Mat* const images[] = {&firstImage, &secondImage};
+  extractOnTwoThreads(extractors, images, first);
   first.collectLevels(firstKeypoints, firstDescriptors);
   second.collectLevels(secondKeypoints, secondDescriptors);
 }
 
-void OrbExtractor::extractLevelsInParallel(const cv::Mat& image) {
-  // Level 0 is converted (or copied) in row bands that either thread claims; the thread that
-  // completes the last band finishes level 0 and builds the rest of the pyramid (each level from
-  // the one before) while the other starts on level 0; then levels are taken in order by
-  // whichever thread is free. No step waits for a particular thread, so a thread the scheduler
-  // holds back (threaded SLAM's mapping shares the cores) delays only the band or level it holds;
-  // when the helper starts late, the caller converts every band itself. Which thread does a band
-  // or a level changes nothing in the output. Why: docs/notes/2026-11-27-speed-paced-and-pairs.md.
+void OrbExtractor::extractOnTwoThreads(std::span<OrbExtractor* const> extractors, std::span<const cv::Mat* const> images,
+                                       OrbExtractor& helperOwner) {
+  // Each image's level 0 is converted (or copied) in row bands that either thread claims; the
+  // thread that completes an image's last band finishes its level 0 and builds the rest of its
+  // pyramid (each level from the one before) while the other goes on; then the levels, largest
+  // first (level l of every image before level l + 1), go to whichever thread is free. No step
+  // waits for a particular thread, so a thread the scheduler holds back (threaded SLAM's mapping
+  // shares the cores) delays only the band or level it holds; when the helper starts late, the
+  // caller does everything itself. Which thread does a band or a level changes nothing in the
+  // output. Why: docs/notes/2026-11-27-speed-paced-and-pairs.md.
   constexpr int kBands = 8;
-  const int n = levels();
-  pyramid_.allocate(image.size(), scales_);
-  std::atomic<int> bandsClaimed{0}, bandsDone{0};
-  std::atomic<int> built{0};  // levels 0 .. built - 1 are ready to read; n + 1: stop, nothing more comes
-  std::atomic<int> next{0};
-  auto publish = [&](int value) {
-    built.store(value, std::memory_order_release);
-    built.notify_all();
+  constexpr std::size_t kMaxImages = 2;
+  const std::size_t m = extractors.size();
+  CV_Assert(m == images.size() && m >= 1 && m <= kMaxImages);
+  std::array<int, kMaxImages> n{};
+  int maxLevels = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    n[i] = extractors[i]->levels();
+    maxLevels = std::max(maxLevels, n[i]);
+    extractors[i]->pyramid_.allocate(images[i]->size(), extractors[i]->scales_);
+  }
+  std::vector<std::pair<std::size_t, int>> tasks;  // (image, level)
+  for (int l = 0; l < maxLevels; ++l)
+    for (std::size_t i = 0; i < m; ++i)
+      if (l < n[i]) tasks.emplace_back(i, l);
+  std::array<std::atomic<int>, kMaxImages> bandsDone{};
+  // Per image: levels 0 .. built - 1 are ready to read; n + 1: stop, nothing more comes.
+  std::array<std::atomic<int>, kMaxImages> built{};
+  std::atomic<int> bandsClaimed{0}, next{0};
+  auto publish = [&](std::size_t i, int value) {
+    built[i].store(value, std::memory_order_release);
+    built[i].notify_all();
   };
-  // Converts bands while any is unclaimed; the thread that completes the last one builds the pyramid.
+  auto stopAll = [&] {
+    for (std::size_t i = 0; i < m; ++i) publish(i, n[i] + 1);
+  };
   auto convertAndBuild = [&] {
-    for (int b = bandsClaimed++; b < kBands; b = bandsClaimed++) {
-      pyramid_.setLevel0Rows(image, image.rows * b / kBands, image.rows * (b + 1) / kBands);
-      if (bandsDone.fetch_add(1, std::memory_order_acq_rel) != kBands - 1) continue;
-      pyramid_.finishLevel0();
-      publish(1);
-      for (int l = 1; l < n; ++l) {
-        pyramid_.buildLevel(l);
-        publish(l + 1);
+    const int bands = static_cast<int>(m) * kBands;
+    for (int t = bandsClaimed++; t < bands; t = bandsClaimed++) {
+      const auto i = static_cast<std::size_t>(t / kBands);
+      const int b = t % kBands, rows = images[i]->rows;
+      ImagePyramid& pyramid = extractors[i]->pyramid_;
+      pyramid.setLevel0Rows(*images[i], rows * b / kBands, rows * (b + 1) / kBands);
+      if (bandsDone[i].fetch_add(1, std::memory_order_acq_rel) != kBands - 1) continue;
+      pyramid.finishLevel0();
+      publish(i, 1);
+      for (int l = 1; l < n[i]; ++l) {
+        pyramid.buildLevel(l);
+        publish(i, l + 1);
       }
     }
   };
-  auto work = [&](LevelScratch& s) {
-    for (int l = next++; l < n; l = next++) {
-      int ready = built.load(std::memory_order_acquire);
-      for (; ready <= l; ready = built.load(std::memory_order_acquire)) built.wait(ready, std::memory_order_acquire);
-      if (ready > n) return;
-      extractLevel(l, s);
+  auto work = [&](std::size_t thread) {
+    for (auto t = static_cast<std::size_t>(next++); t < tasks.size(); t = static_cast<std::size_t>(next++)) {
+      const auto [i, l] = tasks[t];
+      int ready = built[i].load(std::memory_order_acquire);
+      for (; ready <= l; ready = built[i].load(std::memory_order_acquire)) built[i].wait(ready, std::memory_order_acquire);
+      if (ready > n[i]) return;
+      extractors[i]->extractLevel(l, extractors[i]->scratch_[thread]);
     }
   };
-  if (!helper_) helper_ = std::make_unique<HelperThread>();
+  if (!helperOwner.helper_) helperOwner.helper_ = std::make_unique<HelperThread>();
   std::exception_ptr helperError;
-  helper_->run([&] {
+  helperOwner.helper_->run([&] {
     try {
       convertAndBuild();
-      work(scratch_[1]);
+      work(1);
     } catch (...) {
       helperError = std::current_exception();
-      publish(n + 1);  // the caller must not wait for a level this thread will never build
+      stopAll();  // the caller must not wait for a level this thread will never build
     }
   });
   {
-    HelperThread::JoinGuard joinHelper(*helper_);
-    // Declared after the join guard so it runs first: a throw below must not leave the helper
-    // waiting for a level that will never be built.
-    const StopLevelsOnThrow release(built, n + 1);
-    convertAndBuild();
-    work(scratch_[0]);
+    HelperThread::JoinGuard joinHelper(*helperOwner.helper_);
+    try {
+      convertAndBuild();
+      work(0);
+    } catch (...) {
+      stopAll();  // before the join: the helper must not wait for a level this thread will never build
+      throw;
+    }
   }
   if (helperError) std::rethrow_exception(helperError);
 }

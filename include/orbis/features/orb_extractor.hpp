@@ -16,10 +16,10 @@
 // rest of the pyramid while the other starts on level 0, and the levels go to whichever is free
 // (each level's corners, quadtree and descriptors depend on that level alone, so the output is
 // bit-identical to the serial one); for an extractor that runs alone on a frame (monocular,
-// RGB-D). A stereo pair goes through extractPair: each thread builds one image's pyramid, then
-// both take the levels of both images, largest first, as they come free, so that a thread the
-// scheduler holds back (mapping shares the cores) delays a level, not a whole image; the output
-// is bit-identical to extract() on each image.
+// RGB-D). A stereo pair goes through extractPair, the same scheme over both images (the bands
+// of both, then their levels, largest first), so that a thread the scheduler holds back (mapping
+// shares the cores) delays a band or a level, not a whole image; the output is bit-identical to
+// extract() on each image.
 #pragma once
 
 #include <array>
@@ -103,7 +103,10 @@ class OrbExtractor : public PyramidExtractorBase {
     std::vector<int> cellCount, selected, splittable;
   };
 
-  void extractLevelsInParallel(const cv::Mat& image);
+  // The levels of one or two images (one extractor each) on the caller's thread and
+  // helperOwner's helper thread.
+  static void extractOnTwoThreads(std::span<OrbExtractor* const> extractors, std::span<const cv::Mat* const> images,
+                                  OrbExtractor& helperOwner);
   void startLevels(const cv::Mat& image, std::vector<Keypoint>& keypoints, std::vector<OrbDescriptor>& descriptors);
   void collectLevels(std::vector<Keypoint>& keypoints, std::vector<OrbDescriptor>& descriptors) const;
   void extractLevel(int l, LevelScratch& s);
