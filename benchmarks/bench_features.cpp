@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -28,6 +29,7 @@
 #include "orbis/camera/rectification.hpp"
 #include "orbis/features/frame_features.hpp"
 #include "orbis/features/orb_extractor.hpp"
+#include "orbis/util/thread_scheduling.hpp"
 
 
 namespace fs = std::filesystem;
@@ -149,13 +151,20 @@ void BM_CvOrbExtract(benchmark::State& state, std::size_t which) {
   state.counters["keypoints"] = static_cast<double>(total) / static_cast<double>(state.iterations());
 }
 
-// Threads that keep cores busy while they live (arithmetic only, at the caller's priority), like
-// local mapping's threads during a threaded run.
+// How the cores are kept busy beside a row: not at all, by threads at the caller's priority, or by
+// threads at the priority orbis gives its background threads (util/thread_scheduling.hpp).
+enum class Load { kNone, kBusy, kBusyBackground };
+
+// Threads that keep cores busy while they live (arithmetic only), like local mapping's threads
+// during a threaded run.
 class BackgroundLoad {
  public:
-  explicit BackgroundLoad(int threads) {
+  explicit BackgroundLoad(Load load) {
+    const int threads = load == Load::kNone ? 0 : 2;
+    const bool lowered = load == Load::kBusyBackground;
     for (int t = 0; t < threads; ++t)
-      threads_.emplace_back([this] {
+      threads_.emplace_back([this, lowered] {
+        if (lowered) orbis::lowerThisThreadPriority();
         double x = 1.0;
         while (!stop_.load(std::memory_order_relaxed))
           for (int i = 0; i < 1000; ++i) x = x * 1.0000001 + 1e-9;
@@ -172,11 +181,52 @@ class BackgroundLoad {
   std::vector<std::thread> threads_;
 };
 
+// A camera's frame period: the paced rows sleep this long between frames, untimed, as a live
+// camera or ORB-SLAM2's example programs do; caches and idle cores are then as a real run has them.
+constexpr auto kFramePeriod = std::chrono::milliseconds(33);
+
+// One image a frame period apart (wall time of the extraction alone): orbis on one thread or as
+// the monocular and RGB-D sensors run it (two threads, colour input), or cv::ORB on one.
+template <class Extract>
+void timePaced(benchmark::State& state, std::size_t frames, Extract&& extract) {
+  std::size_t frame = 0;
+  for (auto _ : state) {
+    std::this_thread::sleep_for(kFramePeriod);
+    const auto start = std::chrono::steady_clock::now();
+    extract(frame++ % frames);
+    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+}
+
+void BM_OrbisExtractPaced(benchmark::State& state, std::size_t which, bool twoThreads) {
+  const Dataset& d = datasets()[which];
+  const std::vector<cv::Mat>& frames = twoThreads && !d.colour.empty() ? d.colour : d.left;
+  orbis::OrbExtractor extractor(paramsFor(d));
+  extractor.setParallelLevels(twoThreads);
+  std::vector<orbis::Keypoint> kps;
+  std::vector<orbis::OrbDescriptor> desc;
+  timePaced(state, frames.size(), [&](std::size_t i) {
+    extractor.extract(frames[i], kps, desc);
+    benchmark::DoNotOptimize(desc.data());
+  });
+}
+
+void BM_CvOrbExtractPaced(benchmark::State& state, std::size_t which) {
+  const Dataset& d = datasets()[which];
+  auto orb = cvOrbFor(d);
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  timePaced(state, d.left.size(), [&](std::size_t i) {
+    orb->detectAndCompute(d.left[i], cv::noArray(), kps, desc);
+    benchmark::DoNotOptimize(desc.data);
+  });
+}
+
 // One image as the monocular and RGB-D sensors extract it: the levels on two threads, a colour
 // image (where the source has one) converted inside. Wall time.
-void BM_OrbisExtractTwoThreads(benchmark::State& state, std::size_t which, int loadThreads) {
+void BM_OrbisExtractTwoThreads(benchmark::State& state, std::size_t which, Load busy) {
   const Dataset& d = datasets()[which];
-  BackgroundLoad load(loadThreads);
+  BackgroundLoad load(busy);
   const std::vector<cv::Mat>& frames = d.colour.empty() ? d.left : d.colour;
   orbis::OrbExtractor extractor(paramsFor(d));
   extractor.setParallelLevels(true);
@@ -197,9 +247,9 @@ void matchOnTwoThreadsWhereOffered(Matcher& matcher) {
 
 // A rectified pair as the stereo sensor extracts it: orbis::extractStereo (the right image on a
 // second thread, then the matching, on two threads where the matcher offers it). Wall time.
-void BM_OrbisStereoTwoThreads(benchmark::State& state, std::size_t which, int loadThreads) {
+void BM_OrbisStereoTwoThreads(benchmark::State& state, std::size_t which, Load busy) {
   const Dataset& d = datasets()[which];
-  BackgroundLoad load(loadThreads);
+  BackgroundLoad load(busy);
   orbis::OrbExtractor left(paramsFor(d)), right(paramsFor(d));
   orbis::StereoMatcher matcher;
   matchOnTwoThreadsWhereOffered(matcher);
@@ -322,7 +372,8 @@ void printCoverage() {
   }
 }
 
-// Collects per-benchmark CPU time (robust to other load on the machine) so the ratios can be printed after the normal table.
+// Collects per-benchmark CPU and wall time, keyed by the registered name (without the
+// /real_time or /manual_time suffix), so the ratios can be printed after the normal table.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
@@ -332,8 +383,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if ((r.run_type == Run::RT_Iteration && r.iterations > 0) ||
           (r.run_type == Run::RT_Aggregate && r.aggregate_name == "median"))
       {
-        times[r.run_name.str()] = r.GetAdjustedCPUTime();
-        wallTimes[r.run_name.str()] = r.GetAdjustedRealTime();
+        times[r.run_name.function_name] = r.GetAdjustedCPUTime();
+        wallTimes[r.run_name.function_name] = r.GetAdjustedRealTime();
       }
     ConsoleReporter::ReportRuns(runs);
   }
@@ -348,12 +399,28 @@ int main(int argc, char** argv) {
     const std::string& n = datasets()[i].name;
     benchmark::RegisterBenchmark(("Extract/orbis/" + n).c_str(), BM_OrbisExtract, i)->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("Extract/cvORB/" + n).c_str(), BM_CvOrbExtract, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("ExtractTwoThreads/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, 0)
+    benchmark::RegisterBenchmark(("ExtractTwoThreads/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, Load::kNone)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("ExtractTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, 2)
+    benchmark::RegisterBenchmark(("ExtractTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, Load::kBusy)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
+    benchmark::RegisterBenchmark(("ExtractTwoThreadsLoadedBackground/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads,
+                                 i, Load::kBusyBackground)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(("ExtractPaced/orbis/" + n).c_str(), BM_OrbisExtractPaced, i, false)
+        ->Unit(benchmark::kMillisecond)
+        ->UseManualTime()
+        ->Iterations(60);
+    benchmark::RegisterBenchmark(("ExtractTwoThreadsPaced/orbis/" + n).c_str(), BM_OrbisExtractPaced, i, true)
+        ->Unit(benchmark::kMillisecond)
+        ->UseManualTime()
+        ->Iterations(60);
+    benchmark::RegisterBenchmark(("ExtractPaced/cvORB/" + n).c_str(), BM_CvOrbExtractPaced, i)
+        ->Unit(benchmark::kMillisecond)
+        ->UseManualTime()
+        ->Iterations(60);
   }
   for (std::size_t i = 0; i < datasets().size(); ++i) {
     if (datasets()[i].rectifiedLeft.empty()) continue;
@@ -365,10 +432,14 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("StereoMatchOnlyTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i, true)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("StereoTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, 0)
+    benchmark::RegisterBenchmark(("StereoTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, Load::kNone)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("StereoTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, 2)
+    benchmark::RegisterBenchmark(("StereoTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, Load::kBusy)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(("StereoTwoThreadsLoadedBackground/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads,
+                                 i, Load::kBusyBackground)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }
@@ -398,10 +469,31 @@ int main(int argc, char** argv) {
     if (fl != reporter.wallTimes.end() && f != reporter.wallTimes.end())
       std::printf("%-16s extraction as SLAM runs it, two busy threads beside / idle (wall) %.3f\n", d.name.c_str(),
                   fl->second / f->second);
+    const auto fb = reporter.wallTimes.find("ExtractTwoThreadsLoadedBackground/orbis/" + d.name);
+    if (fb != reporter.wallTimes.end() && f != reporter.wallTimes.end())
+      std::printf("%-16s extraction as SLAM runs it, two busy background-priority threads beside / idle (wall) %.3f\n",
+                  d.name.c_str(), fb->second / f->second);
+    // Paced: a frame period between images, against the same extraction back to back.
+    const auto fp = reporter.wallTimes.find("ExtractTwoThreadsPaced/orbis/" + d.name);
+    if (fp != reporter.wallTimes.end() && f != reporter.wallTimes.end())
+      std::printf("%-16s extraction as SLAM runs it, paced / back to back (wall) %.3f\n", d.name.c_str(),
+                  fp->second / f->second);
+    const auto op = reporter.wallTimes.find("ExtractPaced/orbis/" + d.name);
+    const auto o = reporter.wallTimes.find("Extract/orbis/" + d.name);
+    if (op != reporter.wallTimes.end() && o != reporter.wallTimes.end())
+      std::printf("%-16s extraction on one thread, paced / back to back (wall) %.3f\n", d.name.c_str(),
+                  op->second / o->second);
+    const auto cp = reporter.wallTimes.find("ExtractPaced/cvORB/" + d.name);
+    if (cp != reporter.wallTimes.end() && g != reporter.wallTimes.end())
+      std::printf("%-16s cv::ORB paced / back to back (wall) %.3f\n", d.name.c_str(), cp->second / g->second);
     const auto hl = reporter.wallTimes.find("StereoTwoThreadsLoaded/orbis/" + d.name);
     if (hl != reporter.wallTimes.end() && h != reporter.wallTimes.end())
       std::printf("%-16s stereo pair as SLAM runs it, two busy threads beside / idle (wall) %.3f\n", d.name.c_str(),
                   hl->second / h->second);
+    const auto hb = reporter.wallTimes.find("StereoTwoThreadsLoadedBackground/orbis/" + d.name);
+    if (hb != reporter.wallTimes.end() && h != reporter.wallTimes.end())
+      std::printf("%-16s stereo pair as SLAM runs it, two busy background-priority threads beside / idle (wall) %.3f\n",
+                  d.name.c_str(), hb->second / h->second);
   }
   printCoverage();
   benchmark::Shutdown();

@@ -64,6 +64,9 @@ namespace orbis {
 struct LoopCloserOptions {
   // Runs on its own thread (false: inline, deterministic mode).
   bool threaded = true;
+  // Threaded: loop closing and full BA run at a lower priority than their creator
+  // (util/thread_scheduling.hpp).
+  bool backgroundPriority = true;
   std::uint32_t seed = 0;               // RANSAC generator
   int consistencyThreshold = 3;         // consecutive keyframes a candidate group must persist
   int keyFramesAfterLoop = 10;          // no detection this soon after the last loop (ORB-SLAM)

@@ -24,10 +24,13 @@ LoopCloser<Sensor>::LoopCloser(const Camera& camera, Map& map, LocalMappingContr
       options_(std::move(options)),
       timer_(timer),
       rng_(options_.seed) {
-  if (options_.threaded) worker_.start([this] {
-      while (!worker_.finishing() && processOne()) {
-      }
-    });
+  if (options_.threaded)
+    worker_.start(
+        [this] {
+          while (!worker_.finishing() && processOne()) {
+          }
+        },
+        options_.backgroundPriority);
 }
 
 template <SensorConfiguration Sensor>

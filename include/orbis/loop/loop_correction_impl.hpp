@@ -13,6 +13,7 @@
 #include "orbis/map/map_bundle_adjustment.hpp"
 #include "orbis/map/map_matching.hpp"
 #include "orbis/optim/pose_graph.hpp"
+#include "orbis/util/thread_scheduling.hpp"
 
 namespace orbis {
 
@@ -237,6 +238,7 @@ void LoopCloser<Sensor>::startFullBundleAdjustment(std::uint32_t mapId) {
     return;
   }
   fullBaThread_ = std::thread([this] {
+    if (options_.backgroundPriority) lowerThisThreadPriority();
     runFullBundleAdjustment();
     fullBaRunning_ = false;
   });

@@ -35,6 +35,8 @@ namespace orbis {
 struct LocalMapperOptions {
   // Runs on its own thread (false: inline, deterministic mode).
   bool threaded = true;
+  // Threaded: the thread runs at a lower priority than its creator (util/thread_scheduling.hpp).
+  bool backgroundPriority = true;
   int triangulationNeighbours = 10;  // covisible keyframes searched for new points (stereo)
   double redundancyRatio = 0.9;      // keyframe culling: share of points seen elsewhere
   // Whether redundant keyframes are culled.

@@ -55,6 +55,10 @@ struct SlamOptions {
   // buffers are then not faulted in again page by page. Process-wide, so it stays set after the
   // system is gone; false leaves malloc's settings alone.
   bool retainFreedMemory = true;
+  // Threaded mode: local mapping, loop closing and full BA run at a lower priority than tracking
+  // (util/thread_scheduling.hpp), so on a busy machine a frame's tracking gets the cores first
+  // and mapping the rest; results do not change. Why: docs/notes/2026-11-27-speed-scheduling.md.
+  bool backgroundPriority = true;
   // @{
   // The atlas (issue 32; docs/guide/atlas.md): a new map when relocalisation has failed on
   // newMapAfterLostFrames frames that could start one, over newMapAfterLostSeconds; maps merged

@@ -19,10 +19,12 @@ SlamCore<Sensor>::SlamCore(const Camera& camera, std::shared_ptr<const OrbVocabu
   if (options_.retainFreedMemory) retainFreedMemory();
   LocalMapperOptions mapperOptions;
   mapperOptions.threaded = !options_.deterministic;
+  mapperOptions.backgroundPriority = options_.backgroundPriority;
   mapper_ = std::make_unique<LocalMapper<Sensor>>(camera_, map_, mapperOptions, &timer_);
   if (options_.loopClosing && !options_.localisationOnly) {
     LoopCloserOptions loopOptions;
     loopOptions.threaded = !options_.deterministic;
+    loopOptions.backgroundPriority = options_.backgroundPriority;
     loopOptions.seed = options_.seed;
     loopOptions.mergeMaps = options_.atlas;
     loopCloser_ = std::make_unique<LoopCloser<Sensor>>(camera_, map_, mapper_.get(), database_, loopOptions, &timer_);

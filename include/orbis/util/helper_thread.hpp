@@ -9,6 +9,8 @@
 // join() before the next run() and before anything the job refers to goes away (JoinGuard does
 // it on every path out of a scope). The thread starts on the first run() and is joined by the
 // destructor. The job must not throw. Everything the job did happens-before join()'s return.
+// run() wakes the thread on a core other than the caller's (WakeSteering), so that after a
+// camera's frame period of idling the job does not wait for the caller's core.
 #pragma once
 
 #include <condition_variable>
@@ -16,6 +18,8 @@
 #include <mutex>
 #include <thread>
 #include <utility>
+
+#include "orbis/util/thread_scheduling.hpp"
 
 namespace orbis {
 
@@ -42,6 +46,7 @@ class HelperThread {
       pending_ = true;
     }
     if (!thread_.joinable()) thread_ = std::thread([this] { serve(); });
+    else steering_.steerAwayFromCaller();
     wake_.notify_one();
   }
 
@@ -66,6 +71,7 @@ class HelperThread {
 
  private:
   void serve() {
+    steering_.adoptThisThread();
     std::unique_lock lock(mutex_);
     for (;;) {
       wake_.wait(lock, [this] { return stop_ || (pending_ && job_); });
@@ -73,6 +79,7 @@ class HelperThread {
       std::function<void()> job = std::move(job_);
       job_ = nullptr;
       lock.unlock();
+      steering_.settle();
       job();
       lock.lock();
       pending_ = false;
@@ -85,6 +92,7 @@ class HelperThread {
   std::function<void()> job_;
   bool pending_ = false;  // a job was handed over and has not returned yet
   bool stop_ = false;
+  WakeSteering steering_;
   std::thread thread_;
 };
 

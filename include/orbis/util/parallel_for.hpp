@@ -3,9 +3,10 @@
 // Contract: parallelFor(threads, tasks, f) calls f(task) exactly once for every task in
 // [0, tasks) and returns when all have returned. The caller's thread takes tasks too; up to
 // threads - 1 helpers of a process-wide pool (started on first use, one fewer than the
-// hardware's cores, at least one) take the others. Which thread runs a task is unspecified, so a
-// caller that wants the same result at any thread count makes each task's output depend on the
-// task alone. threads <= 1 or tasks <= 1 runs inline; so does a call made while the helpers serve
+// hardware's cores, at least one) take the others; callers at background priority
+// (util/thread_scheduling.hpp) have a pool of their own, whose helpers run at that priority too.
+// Which thread runs a task is unspecified, so a caller that wants the same result at any thread
+// count makes each task's output depend on the task alone. threads <= 1 or tasks <= 1 runs inline; so does a call made while the helpers serve
 // another caller (local BA and a loop's full BA never wait for each other's helpers). f must not
 // throw. Waking a helper costs a few microseconds: worth it for work of tens of microseconds.
 #pragma once
@@ -18,13 +19,20 @@
 #include <thread>
 #include <vector>
 
+#include "orbis/util/thread_scheduling.hpp"
+
 namespace orbis {
 
 namespace parallel_detail {
 
 class HelperPool {
  public:
-  static HelperPool& instance() {
+  // The pool for callers at background priority (util/thread_scheduling.hpp) or for the others.
+  static HelperPool& instance(bool background) {
+    if (background) {
+      static HelperPool pool;
+      return pool;
+    }
     static HelperPool pool;
     return pool;
   }
@@ -62,6 +70,8 @@ class HelperPool {
   }
 
  private:
+  // Helpers inherit their creator's priority: the background pool is made by its first caller,
+  // which is a background thread.
   HelperPool() {
     const int n = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1);
     for (int i = 0; i < n; ++i) threads_.emplace_back([this, i] { serve(i); });
@@ -111,7 +121,7 @@ template <class F>
 void parallelFor(int threads, int tasks, F&& f) {
   if (threads > 1 && tasks > 1) {
     const std::function<void(int)> job = [&f](int task) { f(task); };
-    if (parallel_detail::HelperPool::instance().tryRun(std::min(threads, tasks) - 1, tasks, job)) return;
+    if (parallel_detail::HelperPool::instance(isThisThreadBackground()).tryRun(std::min(threads, tasks) - 1, tasks, job)) return;
   }
   for (int t = 0; t < tasks; ++t) f(t);
 }

@@ -20,6 +20,8 @@
 #include <optional>
 #include <thread>
 
+#include "orbis/util/thread_scheduling.hpp"
+
 namespace orbis {
 
 // A queue of items served by one worker thread (or inline, when never started): local mapping's and
@@ -32,9 +34,11 @@ class QueueWorker {
   QueueWorker& operator=(const QueueWorker&) = delete;
   ~QueueWorker() { stop(); }
 
-  // Starts the thread, which calls serve() whenever items are queued or it is woken.
-  void start(std::function<void()> serve) {
-    thread_ = std::thread([this, serve = std::move(serve)] {
+  // Starts the thread, which calls serve() whenever items are queued or it is woken; with
+  // `background` at a lower priority than the caller's (util/thread_scheduling.hpp).
+  void start(std::function<void()> serve, bool background = false) {
+    thread_ = std::thread([this, background, serve = std::move(serve)] {
+      if (background) lowerThisThreadPriority();
       while (!finishing()) {
         {
           std::unique_lock lock(mutex_);

@@ -1,0 +1,149 @@
+// Scheduler hints: background priority lowers this thread only and reaches parallelFor's helpers;
+// WakeSteering keeps a woken helper off its waker's core until it settles, then gives it back
+// every core it had.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "orbis/util/helper_thread.hpp"
+#include "orbis/util/parallel_for.hpp"
+#include "orbis/util/thread_scheduling.hpp"
+
+#if defined(__linux__)
+#include <sched.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
+namespace orbis {
+namespace {
+
+#if defined(__linux__)
+
+int niceOfThisThread() { return ::getpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid))); }
+
+TEST(ThreadScheduling, LowersOnlyTheCallingThread) {
+  const int before = niceOfThisThread();
+  if (before + kBackgroundNice > 19) GTEST_SKIP() << "nice " << before << " leaves no room to lower";
+  int inside = 0, after = 0;
+  bool lowered = false, flagged = false;
+  std::thread([&] {
+    lowered = lowerThisThreadPriority();
+    inside = niceOfThisThread();
+    flagged = isThisThreadBackground();
+  }).join();
+  after = niceOfThisThread();
+  EXPECT_TRUE(lowered);
+  EXPECT_EQ(inside, before + kBackgroundNice);
+  // Once: a background thread lowering itself again, or a thread it started, stays where it is.
+  int again = 0, child = 0;
+  std::thread([&] {
+    lowerThisThreadPriority();
+    lowerThisThreadPriority();
+    again = niceOfThisThread();
+    std::thread([&] {
+      lowerThisThreadPriority();
+      child = niceOfThisThread();
+    }).join();
+  }).join();
+  EXPECT_EQ(again, before + kBackgroundNice);
+  EXPECT_EQ(child, before + kBackgroundNice);
+  EXPECT_TRUE(flagged);
+  EXPECT_EQ(after, before);
+  EXPECT_FALSE(isThisThreadBackground());
+}
+
+TEST(ThreadScheduling, BackgroundCallersGetBackgroundHelpers) {
+  const int base = niceOfThisThread();
+  if (base + kBackgroundNice > 19) GTEST_SKIP() << "nice " << base << " leaves no room to lower";
+  std::mutex mutex;
+  std::vector<int> nices;
+  std::thread([&] {
+    ASSERT_TRUE(lowerThisThreadPriority());
+    // Tasks long enough that a helper takes some of them.
+    parallelFor(2, 8, [&](int) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      std::lock_guard lock(mutex);
+      nices.push_back(niceOfThisThread());
+    });
+  }).join();
+  ASSERT_EQ(nices.size(), 8u);
+  for (int n : nices) EXPECT_EQ(n, base + kBackgroundNice);
+  // And a foreground caller's helpers stay at its priority.
+  nices.clear();
+  parallelFor(2, 8, [&](int) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(3));
+    std::lock_guard lock(mutex);
+    nices.push_back(niceOfThisThread());
+  });
+  ASSERT_EQ(nices.size(), 8u);
+  for (int n : nices) EXPECT_EQ(n, base);
+}
+
+cpu_set_t affinityOf(pid_t tid) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  ::sched_getaffinity(tid, sizeof(set), &set);
+  return set;
+}
+
+TEST(ThreadScheduling, SteeringExcludesTheWakersCoreUntilSettled) {
+  cpu_set_t mine = affinityOf(0);
+  if (CPU_COUNT(&mine) < 2) GTEST_SKIP() << "one core: nothing to steer to";
+  WakeSteering steering;
+  std::atomic<pid_t> helper{0};
+  std::atomic<int> stage{0};
+  std::thread t([&] {
+    steering.adoptThisThread();
+    helper = static_cast<pid_t>(::syscall(SYS_gettid));
+    stage = 1;
+    while (stage.load() != 2) std::this_thread::yield();
+    steering.settle();
+    stage = 3;
+  });
+  while (stage.load() != 1) std::this_thread::yield();
+  // Pinned to one core, so the core the steering excludes is known.
+  const int core = ::sched_getcpu();
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(core, &one);
+  ASSERT_EQ(::sched_setaffinity(0, sizeof(one), &one), 0);
+  ASSERT_TRUE(steering.steerAwayFromCaller());
+  const cpu_set_t steered = affinityOf(helper);
+  EXPECT_FALSE(CPU_ISSET(core, &steered));
+  EXPECT_EQ(CPU_COUNT(&steered), CPU_COUNT(&mine) - 1);
+  stage = 2;
+  while (stage.load() != 3) std::this_thread::yield();
+  const cpu_set_t settled = affinityOf(helper);
+  EXPECT_TRUE(CPU_EQUAL(&settled, &mine));
+  t.join();
+  ::sched_setaffinity(0, sizeof(mine), &mine);
+}
+
+TEST(ThreadScheduling, HelperThreadKeepsItsCoresBetweenJobs) {
+  cpu_set_t mine = affinityOf(0);
+  HelperThread helper;
+  for (int i = 0; i < 20; ++i) {
+    cpu_set_t during;
+    helper.run([&] { during = affinityOf(0); });
+    helper.join();
+    EXPECT_TRUE(CPU_EQUAL(&during, &mine)) << "job " << i << " ran with its cores narrowed";
+  }
+}
+
+#else
+
+TEST(ThreadScheduling, DoesNothingOffLinux) {
+  EXPECT_FALSE(lowerThisThreadPriority());
+  EXPECT_FALSE(isThisThreadBackground());
+}
+
+#endif
+
+}  // namespace
+}  // namespace orbis
