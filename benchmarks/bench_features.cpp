@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <opencv2/features2d.hpp>
@@ -393,55 +394,47 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 }  // namespace
 
+// Registration helpers: one thread's CPU time, several threads' wall time, or the paced rows'
+// manually timed extraction (60 frames, a frame period apart).
+template <class... Args>
+void cpuRow(const std::string& name, Args&&... args) {
+  benchmark::RegisterBenchmark(name.c_str(), std::forward<Args>(args)...)->Unit(benchmark::kMillisecond);
+}
+template <class... Args>
+void wallRow(const std::string& name, Args&&... args) {
+  benchmark::RegisterBenchmark(name.c_str(), std::forward<Args>(args)...)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+template <class... Args>
+void pacedRow(const std::string& name, Args&&... args) {
+  benchmark::RegisterBenchmark(name.c_str(), std::forward<Args>(args)...)
+      ->Unit(benchmark::kMillisecond)
+      ->UseManualTime()
+      ->Iterations(60);
+}
+
 int main(int argc, char** argv) {
   cv::setNumThreads(1);  // both sides single-threaded, so the ratio compares algorithms
   for (std::size_t i = 0; i < datasets().size(); ++i) {
     const std::string& n = datasets()[i].name;
-    benchmark::RegisterBenchmark(("Extract/orbis/" + n).c_str(), BM_OrbisExtract, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("Extract/cvORB/" + n).c_str(), BM_CvOrbExtract, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("ExtractTwoThreads/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, Load::kNone)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("ExtractTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads, i, Load::kBusy)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("ExtractTwoThreadsLoadedBackground/orbis/" + n).c_str(), BM_OrbisExtractTwoThreads,
-                                 i, Load::kBusyBackground)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("ExtractPaced/orbis/" + n).c_str(), BM_OrbisExtractPaced, i, false)
-        ->Unit(benchmark::kMillisecond)
-        ->UseManualTime()
-        ->Iterations(60);
-    benchmark::RegisterBenchmark(("ExtractTwoThreadsPaced/orbis/" + n).c_str(), BM_OrbisExtractPaced, i, true)
-        ->Unit(benchmark::kMillisecond)
-        ->UseManualTime()
-        ->Iterations(60);
-    benchmark::RegisterBenchmark(("ExtractPaced/cvORB/" + n).c_str(), BM_CvOrbExtractPaced, i)
-        ->Unit(benchmark::kMillisecond)
-        ->UseManualTime()
-        ->Iterations(60);
+    cpuRow("Extract/orbis/" + n, BM_OrbisExtract, i);
+    cpuRow("Extract/cvORB/" + n, BM_CvOrbExtract, i);
+    wallRow("ExtractTwoThreads/orbis/" + n, BM_OrbisExtractTwoThreads, i, Load::kNone);
+    wallRow("ExtractTwoThreadsLoaded/orbis/" + n, BM_OrbisExtractTwoThreads, i, Load::kBusy);
+    wallRow("ExtractTwoThreadsLoadedBackground/orbis/" + n, BM_OrbisExtractTwoThreads, i, Load::kBusyBackground);
+    pacedRow("ExtractPaced/orbis/" + n, BM_OrbisExtractPaced, i, false);
+    pacedRow("ExtractTwoThreadsPaced/orbis/" + n, BM_OrbisExtractPaced, i, true);
+    pacedRow("ExtractPaced/cvORB/" + n, BM_CvOrbExtractPaced, i);
   }
   for (std::size_t i = 0; i < datasets().size(); ++i) {
     if (datasets()[i].rectifiedLeft.empty()) continue;
     const std::string& n = datasets()[i].name;
-    benchmark::RegisterBenchmark(("Stereo/orbis/" + n).c_str(), BM_OrbisStereo, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("Stereo/cvORB/" + n).c_str(), BM_CvOrbStereo, i)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("StereoMatchOnly/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i, false)
-        ->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("StereoMatchOnlyTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoMatchOnly, i, true)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("StereoTwoThreads/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, Load::kNone)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("StereoTwoThreadsLoaded/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads, i, Load::kBusy)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("StereoTwoThreadsLoadedBackground/orbis/" + n).c_str(), BM_OrbisStereoTwoThreads,
-                                 i, Load::kBusyBackground)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    cpuRow("Stereo/orbis/" + n, BM_OrbisStereo, i);
+    cpuRow("Stereo/cvORB/" + n, BM_CvOrbStereo, i);
+    cpuRow("StereoMatchOnly/orbis/" + n, BM_OrbisStereoMatchOnly, i, false);
+    wallRow("StereoMatchOnlyTwoThreads/orbis/" + n, BM_OrbisStereoMatchOnly, i, true);
+    wallRow("StereoTwoThreads/orbis/" + n, BM_OrbisStereoTwoThreads, i, Load::kNone);
+    wallRow("StereoTwoThreadsLoaded/orbis/" + n, BM_OrbisStereoTwoThreads, i, Load::kBusy);
+    wallRow("StereoTwoThreadsLoadedBackground/orbis/" + n, BM_OrbisStereoTwoThreads, i, Load::kBusyBackground);
   }
   benchmark::Initialize(&argc, argv);
   RatioReporter reporter;
@@ -471,7 +464,7 @@ int main(int argc, char** argv) {
                   fl->second / f->second);
     const auto fb = reporter.wallTimes.find("ExtractTwoThreadsLoadedBackground/orbis/" + d.name);
     if (fb != reporter.wallTimes.end() && f != reporter.wallTimes.end())
-      std::printf("%-16s extraction as SLAM runs it, two busy background-priority threads beside / idle (wall) %.3f\n",
+      std::printf("%-16s extraction as SLAM runs it, two busy background threads beside / idle (wall) %.3f\n",
                   d.name.c_str(), fb->second / f->second);
     // Paced: a frame period between images, against the same extraction back to back.
     const auto fp = reporter.wallTimes.find("ExtractTwoThreadsPaced/orbis/" + d.name);
@@ -492,7 +485,7 @@ int main(int argc, char** argv) {
                   hl->second / h->second);
     const auto hb = reporter.wallTimes.find("StereoTwoThreadsLoadedBackground/orbis/" + d.name);
     if (hb != reporter.wallTimes.end() && h != reporter.wallTimes.end())
-      std::printf("%-16s stereo pair as SLAM runs it, two busy background-priority threads beside / idle (wall) %.3f\n",
+      std::printf("%-16s stereo pair as SLAM runs it, two busy background threads beside / idle (wall) %.3f\n",
                   d.name.c_str(), hb->second / h->second);
   }
   printCoverage();

@@ -6,9 +6,10 @@
 // hardware's cores, at least one) take the others; callers at background priority
 // (util/thread_scheduling.hpp) have a pool of their own, whose helpers run at that priority too.
 // Which thread runs a task is unspecified, so a caller that wants the same result at any thread
-// count makes each task's output depend on the task alone. threads <= 1 or tasks <= 1 runs inline; so does a call made while the helpers serve
-// another caller (local BA and a loop's full BA never wait for each other's helpers). f must not
-// throw. Waking a helper costs a few microseconds: worth it for work of tens of microseconds.
+// count makes each task's output depend on the task alone. threads <= 1 or tasks <= 1 runs
+// inline; so does a call made while the helpers serve another caller (local BA and a loop's full
+// BA never wait for each other's helpers). f must not throw. Waking a helper costs a few
+// microseconds: worth it for work of tens of microseconds.
 #pragma once
 
 #include <algorithm>
@@ -121,7 +122,8 @@ template <class F>
 void parallelFor(int threads, int tasks, F&& f) {
   if (threads > 1 && tasks > 1) {
     const std::function<void(int)> job = [&f](int task) { f(task); };
-    if (parallel_detail::HelperPool::instance(isThisThreadBackground()).tryRun(std::min(threads, tasks) - 1, tasks, job)) return;
+    auto& pool = parallel_detail::HelperPool::instance(isThisThreadBackground());
+    if (pool.tryRun(std::min(threads, tasks) - 1, tasks, job)) return;
   }
   for (int t = 0; t < tasks; ++t) f(t);
 }
