@@ -88,7 +88,7 @@ TEST(ThreadScheduling, BackgroundCallersGetBackgroundHelpers) {
 cpu_set_t affinityOf(pid_t tid) {
   cpu_set_t set;
   CPU_ZERO(&set);
-  ::sched_getaffinity(tid, sizeof(set), &set);
+  EXPECT_EQ(::sched_getaffinity(tid, sizeof(set), &set), 0) << "thread " << tid;
   return set;
 }
 
@@ -105,6 +105,7 @@ TEST(ThreadScheduling, SteeringExcludesTheWakersCoreUntilSettled) {
     while (stage.load() != 2) std::this_thread::yield();
     steering.settle();
     stage = 3;
+    while (stage.load() != 4) std::this_thread::yield();  // alive until its cores are read
   });
   while (stage.load() != 1) std::this_thread::yield();
   // Pinned to one core, so the core the steering excludes is known.
@@ -112,16 +113,22 @@ TEST(ThreadScheduling, SteeringExcludesTheWakersCoreUntilSettled) {
   cpu_set_t one;
   CPU_ZERO(&one);
   CPU_SET(core, &one);
-  ASSERT_EQ(::sched_setaffinity(0, sizeof(one), &one), 0);
-  ASSERT_TRUE(steering.steerAwayFromCaller());
-  const cpu_set_t steered = affinityOf(helper);
-  EXPECT_FALSE(CPU_ISSET(core, &steered));
-  EXPECT_EQ(CPU_COUNT(&steered), CPU_COUNT(&mine) - 1);
+  // No ASSERT until the thread is joined: it waits for the stages below.
+  const bool pinned = ::sched_setaffinity(0, sizeof(one), &one) == 0;
+  EXPECT_TRUE(pinned);
+  const bool steered = pinned && steering.steerAwayFromCaller();
+  EXPECT_TRUE(steered);
+  if (steered) {
+    const cpu_set_t narrowed = affinityOf(helper);
+    EXPECT_FALSE(CPU_ISSET(core, &narrowed));
+    EXPECT_EQ(CPU_COUNT(&narrowed), CPU_COUNT(&mine) - 1);
+  }
   stage = 2;
   while (stage.load() != 3) std::this_thread::yield();
   const cpu_set_t settled = affinityOf(helper);
-  EXPECT_TRUE(CPU_EQUAL(&settled, &mine));
+  stage = 4;
   t.join();
+  EXPECT_TRUE(CPU_EQUAL(&settled, &mine));
   ::sched_setaffinity(0, sizeof(mine), &mine);
 }
 
