@@ -440,53 +440,36 @@ int main(int argc, char** argv) {
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   std::printf("\nTime ratio orbis / cv::ORB (same budget, same run; <= 1.00 is the goal)\n");
+  // One line "dataset what ratio" when both rows ran (a filter may have left either out).
+  auto ratio = [](const std::map<std::string, double>& times, const std::string& dataset, const std::string& what,
+                  const std::string& numerator, const std::string& denominator) {
+    const auto a = times.find(numerator + dataset), b = times.find(denominator + dataset);
+    if (a != times.end() && b != times.end())
+      std::printf("%-16s %s %.3f\n", dataset.c_str(), what.c_str(), a->second / b->second);
+  };
   for (const Dataset& d : datasets()) {
-    const auto a = reporter.times.find("Extract/orbis/" + d.name);
-    const auto b = reporter.times.find("Extract/cvORB/" + d.name);
-    if (a != reporter.times.end() && b != reporter.times.end())
-      std::printf("%-16s extraction %.3f\n", d.name.c_str(), a->second / b->second);
-    const auto c = reporter.times.find("Stereo/orbis/" + d.name);
-    const auto e = reporter.times.find("Stereo/cvORB/" + d.name);
-    if (c != reporter.times.end() && e != reporter.times.end())
-      std::printf("%-16s stereo pair (2 extractions + matching) %.3f\n", d.name.c_str(), c->second / e->second);
-    const auto f = reporter.wallTimes.find("ExtractTwoThreads/orbis/" + d.name);
-    const auto g = reporter.wallTimes.find("Extract/cvORB/" + d.name);
-    if (f != reporter.wallTimes.end() && g != reporter.wallTimes.end())
-      std::printf("%-16s extraction as SLAM runs it (two threads%s, wall) %.3f\n", d.name.c_str(),
-                  d.colour.empty() ? "" : ", colour input", f->second / g->second);
-    const auto h = reporter.wallTimes.find("StereoTwoThreads/orbis/" + d.name);
-    if (h != reporter.wallTimes.end() && g != reporter.wallTimes.end())
-      std::printf("%-16s stereo pair as SLAM runs it (two threads, wall) %.3f\n", d.name.c_str(), h->second / g->second);
+    const auto& cpu = reporter.times;
+    const auto& wall = reporter.wallTimes;
+    const std::string& n = d.name;
+    const std::string asSlam = "extraction as SLAM runs it";
+    ratio(cpu, n, "extraction", "Extract/orbis/", "Extract/cvORB/");
+    ratio(cpu, n, "stereo pair (2 extractions + matching)", "Stereo/orbis/", "Stereo/cvORB/");
+    ratio(wall, n, asSlam + (d.colour.empty() ? " (two threads, wall)" : " (two threads, colour input, wall)"),
+          "ExtractTwoThreads/orbis/", "Extract/cvORB/");
+    ratio(wall, n, "stereo pair as SLAM runs it (two threads, wall)", "StereoTwoThreads/orbis/", "Extract/cvORB/");
     // Under load: the wall time against the same rows without it (how much a busy machine costs).
-    const auto fl = reporter.wallTimes.find("ExtractTwoThreadsLoaded/orbis/" + d.name);
-    if (fl != reporter.wallTimes.end() && f != reporter.wallTimes.end())
-      std::printf("%-16s extraction as SLAM runs it, two busy threads beside / idle (wall) %.3f\n", d.name.c_str(),
-                  fl->second / f->second);
-    const auto fb = reporter.wallTimes.find("ExtractTwoThreadsLoadedBackground/orbis/" + d.name);
-    if (fb != reporter.wallTimes.end() && f != reporter.wallTimes.end())
-      std::printf("%-16s extraction as SLAM runs it, two busy background threads beside / idle (wall) %.3f\n",
-                  d.name.c_str(), fb->second / f->second);
+    ratio(wall, n, asSlam + ", two busy threads beside / idle (wall)", "ExtractTwoThreadsLoaded/orbis/",
+          "ExtractTwoThreads/orbis/");
+    ratio(wall, n, asSlam + ", two busy background threads beside / idle (wall)",
+          "ExtractTwoThreadsLoadedBackground/orbis/", "ExtractTwoThreads/orbis/");
     // Paced: a frame period between images, against the same extraction back to back.
-    const auto fp = reporter.wallTimes.find("ExtractTwoThreadsPaced/orbis/" + d.name);
-    if (fp != reporter.wallTimes.end() && f != reporter.wallTimes.end())
-      std::printf("%-16s extraction as SLAM runs it, paced / back to back (wall) %.3f\n", d.name.c_str(),
-                  fp->second / f->second);
-    const auto op = reporter.wallTimes.find("ExtractPaced/orbis/" + d.name);
-    const auto o = reporter.wallTimes.find("Extract/orbis/" + d.name);
-    if (op != reporter.wallTimes.end() && o != reporter.wallTimes.end())
-      std::printf("%-16s extraction on one thread, paced / back to back (wall) %.3f\n", d.name.c_str(),
-                  op->second / o->second);
-    const auto cp = reporter.wallTimes.find("ExtractPaced/cvORB/" + d.name);
-    if (cp != reporter.wallTimes.end() && g != reporter.wallTimes.end())
-      std::printf("%-16s cv::ORB paced / back to back (wall) %.3f\n", d.name.c_str(), cp->second / g->second);
-    const auto hl = reporter.wallTimes.find("StereoTwoThreadsLoaded/orbis/" + d.name);
-    if (hl != reporter.wallTimes.end() && h != reporter.wallTimes.end())
-      std::printf("%-16s stereo pair as SLAM runs it, two busy threads beside / idle (wall) %.3f\n", d.name.c_str(),
-                  hl->second / h->second);
-    const auto hb = reporter.wallTimes.find("StereoTwoThreadsLoadedBackground/orbis/" + d.name);
-    if (hb != reporter.wallTimes.end() && h != reporter.wallTimes.end())
-      std::printf("%-16s stereo pair as SLAM runs it, two busy background threads beside / idle (wall) %.3f\n",
-                  d.name.c_str(), hb->second / h->second);
+    ratio(wall, n, asSlam + ", paced / back to back (wall)", "ExtractTwoThreadsPaced/orbis/", "ExtractTwoThreads/orbis/");
+    ratio(wall, n, "extraction on one thread, paced / back to back (wall)", "ExtractPaced/orbis/", "Extract/orbis/");
+    ratio(wall, n, "cv::ORB paced / back to back (wall)", "ExtractPaced/cvORB/", "Extract/cvORB/");
+    ratio(wall, n, "stereo pair as SLAM runs it, two busy threads beside / idle (wall)", "StereoTwoThreadsLoaded/orbis/",
+          "StereoTwoThreads/orbis/");
+    ratio(wall, n, "stereo pair as SLAM runs it, two busy background threads beside / idle (wall)",
+          "StereoTwoThreadsLoadedBackground/orbis/", "StereoTwoThreads/orbis/");
   }
   printCoverage();
   benchmark::Shutdown();

@@ -20,7 +20,6 @@ thread_local bool background = false;
 
 namespace {
 pid_t thisThreadId() { return static_cast<pid_t>(::syscall(SYS_gettid)); }
-}  // namespace
 
 // The main thread's nice value at the first call: background threads sit kBackgroundNice above
 // it, also those started by a background thread (which inherit its nice value already).
@@ -32,6 +31,7 @@ int baselineNice() {
   }();
   return baseline;
 }
+}  // namespace
 
 bool lowerThisThreadPriority() {
   const auto tid = static_cast<id_t>(thisThreadId());
