@@ -124,9 +124,10 @@ cv::Ptr<cv::ORB> cvOrbFor(const Dataset& d) {
                          p.iniThFast);
 }
 
-void BM_OrbisExtract(benchmark::State& state, std::size_t which) {
+void BM_OrbisExtract(benchmark::State& state, std::size_t which, bool openCvFast) {
   const Dataset& d = datasets()[which];
   orbis::OrbExtractor extractor(paramsFor(d));
+  if (openCvFast) extractor.setOpenCvFast(true);
   std::vector<orbis::Keypoint> kps;
   std::vector<orbis::OrbDescriptor> desc;
   std::size_t frame = 0, total = 0;
@@ -416,7 +417,8 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);  // both sides single-threaded, so the ratio compares algorithms
   for (std::size_t i = 0; i < datasets().size(); ++i) {
     const std::string& n = datasets()[i].name;
-    cpuRow("Extract/orbis/" + n, BM_OrbisExtract, i);
+    cpuRow("Extract/orbis/" + n, BM_OrbisExtract, i, false);
+    cpuRow("ExtractCvFast/orbis/" + n, BM_OrbisExtract, i, true);
     cpuRow("Extract/cvORB/" + n, BM_CvOrbExtract, i);
     wallRow("ExtractTwoThreads/orbis/" + n, BM_OrbisExtractTwoThreads, i, Load::kNone);
     wallRow("ExtractTwoThreadsLoaded/orbis/" + n, BM_OrbisExtractTwoThreads, i, Load::kBusy);
@@ -453,6 +455,7 @@ int main(int argc, char** argv) {
     const std::string& n = d.name;
     const std::string asSlam = "extraction as SLAM runs it";
     ratio(cpu, n, "extraction", "Extract/orbis/", "Extract/cvORB/");
+    ratio(cpu, n, "extraction with cv::FAST instead of our score map", "ExtractCvFast/orbis/", "Extract/cvORB/");
     ratio(cpu, n, "stereo pair (2 extractions + matching)", "Stereo/orbis/", "Stereo/cvORB/");
     ratio(wall, n, asSlam + (d.colour.empty() ? " (two threads, wall)" : " (two threads, colour input, wall)"),
           "ExtractTwoThreads/orbis/", "Extract/cvORB/");

@@ -208,9 +208,24 @@ void OrbExtractor::detectCorners(const cv::Mat& level, LevelScratch& s) const {
   // costs 2.6x a 33 px one per pixel (EuRoC, measured). So the searched width is widened to
   // 16k + 1 (into the level's edge margin, which is wider than 16 px, or the neighbouring
   // cells) and the corners outside the area dropped; only the suppression of corners in the
-  // area's last column can see the extra columns.
+  // area's last column can see the extra columns. Where our vectorised FAST runs, the scores of
+  // the whole level are computed once at the lower threshold and each area's corners read from
+  // them, the same corners as cv::FAST's over the same widened areas
+  // (docs/notes/2026-11-27-own-fast.md).
+  const bool scoreMap = !openCvFast_;
+  if (scoreMap)
+    fastScoreMap(level, cv::Rect(minX, minY, level.cols - 3 - minX, maxY - minY),
+                 std::min(params_.iniThFast, params_.minThFast), s.fastScores);
   auto fastIn = [&](int x0, int y0, int x1, int y1, int threshold) {
     const int padded = std::min(((x1 - x0 + 14) / 16) * 16 + 1, level.cols - 3 - x0);  // >= x1 - x0: x1 <= cols - kEdge
+    if (scoreMap) {
+      s.fastCorners.clear();
+      fastCornersOfScoreMap(s.fastScores, cv::Rect(x0 - minX, y0 - minY, padded, y1 - y0), threshold, x1 - minX,
+                            s.fastScratch, s.fastCorners);
+      for (const FastCorner& c : s.fastCorners)
+        corners.push_back({static_cast<float>(c.x + minX), static_cast<float>(c.y + minY), static_cast<float>(c.score)});
+      return;
+    }
     cv::FAST(level(cv::Rect(x0 - 3, y0 - 3, padded + 6, y1 - y0 + 6)), s.fast, threshold, true);
     const auto right = static_cast<float>(x1 - x0 + 3);
     for (const cv::KeyPoint& k : s.fast)

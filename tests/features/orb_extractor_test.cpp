@@ -194,6 +194,36 @@ TEST(OrbExtractor, ParallelLevelsGiveTheSerialBits) {
   }
 }
 
+// The score map (our FAST) and cv::FAST give the extractor the same keypoints and descriptors,
+// on synthetic images of several sizes and, where the data is present, on real frames.
+TEST(OrbExtractor, ScoreMapFastGivesCvFastBits) {
+  OrbParams p;
+  p.features = 1000;
+  OrbExtractor scoreMap(p), openCv(p);
+  scoreMap.setOpenCvFast(false);
+  openCv.setOpenCvFast(true);
+  std::vector<cv::Mat> images;
+  std::uint64_t seed = 21;
+  for (const cv::Size size : {cv::Size(640, 480), cv::Size(1241, 376), cv::Size(97, 83)})
+    images.push_back(test::texturedImage(size.width, size.height, seed++));
+  for (const char* folder : {"tum_fr3_teddy_200/rgb", "kitti_06_first51/sequences/06/image_0",
+                             "euroc_V1_01_easy_95/mav0/cam0/data"})
+    if (const auto dir = test::dataset(folder))
+      for (const auto& file : test::sortedPngs(*dir, 2)) images.push_back(test::readGray(file));
+  for (const cv::Mat& image : images) {
+    std::vector<Keypoint> a, b;
+    std::vector<OrbDescriptor> da, db;
+    scoreMap.extract(image, a, da);
+    openCv.extract(image, b, db);
+    ASSERT_EQ(a.size(), b.size()) << image.size();
+    for (std::size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE(a[i].u == b[i].u && a[i].v == b[i].v && a[i].angle == b[i].angle &&
+                  a[i].response == b[i].response && a[i].octave == b[i].octave)
+          << image.size() << " keypoint " << i;
+    EXPECT_TRUE(da == db) << image.size();
+  }
+}
+
 // A stereo pair extracted together (both threads take both images' levels) gives each
 // extractor's own extract() bits: different sizes, budgets (the right one larger, as with
 // rightFeaturesFactor), grey and colour, frame after frame, and an empty second image.

@@ -32,6 +32,7 @@
 
 #include "orbis/features/descriptor.hpp"
 #include "orbis/features/extractor.hpp"
+#include "orbis/features/fast_corners.hpp"
 #include "orbis/features/image_pyramid.hpp"
 #include "orbis/features/keypoint.hpp"
 #include "orbis/features/orb_params.hpp"
@@ -83,6 +84,10 @@ class OrbExtractor : public PyramidExtractorBase {
   std::span<const int> featuresPerLevel() const { return featuresPerLevel_; }
   // Extract one image's pyramid levels on two threads (the same keypoints and descriptors either way).
   void setParallelLevels(bool on) { parallelLevels_ = on; }
+  /** FAST by cv::FAST (true) or by one score map per level (fast_corners.hpp; false, the default
+   *  where the CPU runs its vector code). Both give the same corners; for comparisons. */
+  void setOpenCvFast(bool on) { openCvFast_ = on; }
+  /** Whether cv::FAST finds the corners (see setOpenCvFast()). */ bool openCvFast() const { return openCvFast_; }
   /** Whether setParallelLevels(true) is in force. */ bool parallelLevels() const { return parallelLevels_; }
 
  private:
@@ -97,6 +102,9 @@ class OrbExtractor : public PyramidExtractorBase {
   // The buffers one level's detection and selection reuse; one per thread working on levels.
   struct LevelScratch {
     std::vector<cv::KeyPoint> fast;
+    cv::Mat fastScores;  // the level's FAST score map (fast_corners.hpp), where vectorised
+    FastScratch fastScratch;
+    std::vector<FastCorner> fastCorners;
     std::vector<Corner> corners, sorted;
     std::vector<std::uint8_t> quadrant;
     std::vector<Node> nodes, nextNodes;
@@ -121,6 +129,7 @@ class OrbExtractor : public PyramidExtractorBase {
   std::vector<std::vector<Keypoint>> levelKeypoints_;        // per level, before concatenation
   std::vector<std::vector<OrbDescriptor>> levelDescriptors_;
   bool parallelLevels_ = false;
+  bool openCvFast_ = !fastScoreMapIsVectorised();
   std::unique_ptr<HelperThread> helper_;  // the second thread of setParallelLevels(true), kept between frames
 };
 

@@ -1,0 +1,92 @@
+// FAST-9 score maps and their corners: the portable code and the run-time choice of the AVX2 code
+// (contract in orbis/features/fast_corners.hpp).
+#include "orbis/features/fast_corners.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+
+#include "fast_corners_avx2.hpp"
+
+namespace orbis {
+namespace {
+
+#include "fast_corner_kernel.inc"
+
+bool cpuHasAvx2() {
+#if defined(ORBIS_HAVE_AVX2_KERNELS) && (defined(__GNUC__) || defined(__clang__))
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}
+
+FastCode resolve(FastCode code) {
+  if (code != FastCode::Best) return code;
+  return cpuHasAvx2() ? FastCode::Avx2 : FastCode::Portable;
+}
+
+// The widest vector any path reads past the end of a row of the suppression's copy.
+constexpr int kMaxLanes = 32;
+
+}  // namespace
+
+bool fastCodeAvailable(FastCode code) { return code != FastCode::Avx2 || cpuHasAvx2(); }
+
+bool fastScoreMapIsVectorised() { return resolve(FastCode::Best) != FastCode::Portable; }
+
+void fastScoreMap(const cv::Mat& image, const cv::Rect& area, int threshold, cv::Mat& scores, FastCode code) {
+  CV_Assert(image.type() == CV_8UC1 && area.x >= 3 && area.y >= 3 && area.x + area.width <= image.cols - 3 &&
+            area.y + area.height <= image.rows - 3 && threshold >= 0 && threshold < 255);
+  CV_Assert(fastCodeAvailable(code));
+  scores.create(area.height, area.width, CV_8UC1);
+  if (area.empty()) return;
+  const std::uint8_t* origin = image.ptr<std::uint8_t>(area.y) + area.x;
+  const auto stride = static_cast<std::ptrdiff_t>(image.step1());
+  const auto scoreStride = static_cast<std::ptrdiff_t>(scores.step1());
+  if (resolve(code) == FastCode::Avx2)
+    detail::fastScoreRowsAvx2(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
+  else
+    scoreRows<ScalarOps, ScalarOps>(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
+}
+
+void fastCornersOfScoreMap(const cv::Mat& scores, const cv::Rect& area, int threshold, int keepBelowX,
+                           FastScratch& scratch, std::vector<FastCorner>& corners, FastCode code) {
+  CV_Assert(scores.type() == CV_8UC1 && (area & cv::Rect(0, 0, scores.cols, scores.rows)) == area);
+  CV_Assert(fastCodeAvailable(code));
+  const int width = std::min(area.width, keepBelowX - area.x);  // columns whose corners are kept
+  if (area.empty() || width <= 0) return;
+  threshold = std::clamp(threshold, 1, 255);  // a score of 0 never beats a neighbour (cv::FAST alike)
+  // A copy with zeros around it: neighbours outside the area count as 0, as in cv::FAST on the
+  // area; columns past `width` stay in, as neighbours.
+  const int lead = kMaxLanes;
+  const std::ptrdiff_t stride = lead + area.width + kMaxLanes + 2;
+  std::vector<std::uint8_t>& padded = scratch.padded;
+  padded.resize(static_cast<std::size_t>(stride * (area.height + 2)));
+  std::memset(padded.data(), 0, static_cast<std::size_t>(stride + lead));
+  for (int y = 0; y < area.height; ++y) {
+    std::uint8_t* row = padded.data() + (y + 1) * stride + lead;
+    std::memcpy(row, scores.ptr<std::uint8_t>(area.y + y) + area.x, static_cast<std::size_t>(area.width));
+    std::memset(row + area.width, 0, static_cast<std::size_t>(stride - area.width));  // and the next lead
+  }
+  std::memset(padded.data() + (area.height + 1) * stride + lead, 0, static_cast<std::size_t>(stride - lead));
+  const bool avx2 = resolve(code) == FastCode::Avx2;
+  const int lanes = avx2 ? 32 : 1;
+  scratch.words.resize(static_cast<std::size_t>((width + lanes - 1) / lanes));
+  std::uint32_t* bits = scratch.words.data();
+  for (int y = 0; y < area.height; ++y) {
+    const std::uint8_t* row = padded.data() + (y + 1) * stride + lead;
+    if (avx2)
+      detail::suppressRowBitsAvx2(row - stride, row, row + stride, width, threshold, bits);
+    else
+      suppressRowBits<ScalarOps>(row - stride, row, row + stride, width, threshold, bits);
+    for (int group = 0, x = 0; x < width; ++group, x += lanes)
+      for (std::uint32_t b = bits[group]; b != 0; b &= b - 1) {
+        const int column = x + std::countr_zero(b);
+        corners.push_back({area.x + column, area.y + y, row[column]});
+      }
+  }
+}
+
+}  // namespace orbis
