@@ -45,10 +45,13 @@ void fastScoreMap(const cv::Mat& image, const cv::Rect& area, int threshold, cv:
   const std::uint8_t* origin = image.ptr<std::uint8_t>(area.y) + area.x;
   const auto stride = static_cast<std::ptrdiff_t>(image.step1());
   const auto scoreStride = static_cast<std::ptrdiff_t>(scores.step1());
-  if (resolve(code) == FastCode::Avx2)
+#if defined(ORBIS_HAVE_AVX2_KERNELS)
+  if (resolve(code) == FastCode::Avx2) {
     detail::fastScoreRowsAvx2(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
-  else
-    scoreRows<ScalarOps, ScalarOps>(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
+    return;
+  }
+#endif
+  scoreRows<ScalarOps, ScalarOps>(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
 }
 
 void fastCornersOfScoreMap(const cv::Mat& scores, const cv::Rect& area, int threshold, int keepBelowX,
@@ -77,9 +80,11 @@ void fastCornersOfScoreMap(const cv::Mat& scores, const cv::Rect& area, int thre
   std::uint32_t* bits = scratch.words.data();
   for (int y = 0; y < area.height; ++y) {
     const std::uint8_t* row = padded.data() + (y + 1) * stride + lead;
+#if defined(ORBIS_HAVE_AVX2_KERNELS)
     if (avx2)
       detail::suppressRowBitsAvx2(row - stride, row, row + stride, width, threshold, bits);
     else
+#endif
       suppressRowBits<ScalarOps>(row - stride, row, row + stride, width, threshold, bits);
     for (int group = 0, x = 0; x < width; ++group, x += lanes)
       for (std::uint32_t b = bits[group]; b != 0; b &= b - 1) {
