@@ -396,22 +396,6 @@ void OrbExtractor::distribute(LevelScratch& s, int wanted, float minX, float min
   }
 }
 
-void orbBlur(const cv::Mat& src, cv::Mat& dst) {
-  // Why not cv::GaussianBlur: on a view into a larger image (our bordered levels) it takes its
-  // floating-point path, which rounds differently from ORB-SLAM2's blur of a cloned level (on
-  // 1.5% of pixels); on a whole image its bit-exact path costs twice this. sepFilter2D with taps
-  // that are exact multiples of 1/256 runs OpenCV's fixed-point separable filter: the same
-  // integer sums as the bit-exact path, ties rounded to even instead of up. EuRoC pyramid,
-  // one thread: 0.55 ms, against 0.64 (view) and 1.09 (whole levels).
-  static const cv::Mat taps = [] {
-    cv::Mat k(OrbExtractor::kBlurSize, 1, CV_32F);
-    for (int i = 0; i < OrbExtractor::kBlurSize; ++i)
-      k.at<float>(i) = static_cast<float>(OrbExtractor::kBlurTapsQ8[static_cast<std::size_t>(i)]) / 256.f;
-    return k;
-  }();
-  cv::sepFilter2D(src, dst, CV_8U, taps, taps, cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT_101);
-}
-
 void OrbExtractor::startLevels(const cv::Mat& image, std::vector<Keypoint>& keypoints,
                                std::vector<OrbDescriptor>& descriptors) {
   detail::checkGrayOrColour8u(image, "OrbExtractor input");
