@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstring>
 
+#include "cpu_dispatch.hpp"
 #include "fast_corners_avx2.hpp"
 
 namespace orbis {
@@ -13,10 +14,10 @@ namespace {
 
 #include "fast_corner_kernel.inc"
 
-bool cpuHasAvx2() {
-#if defined(ORBIS_HAVE_AVX2_KERNELS) && (defined(__GNUC__) || defined(__clang__))
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
+// Whether the AVX2 kernels are both built and runnable here.
+bool avx2Kernels() {
+#if defined(ORBIS_HAVE_AVX2_KERNELS)
+  return detail::cpuHasAvx2();
 #else
   return false;
 #endif
@@ -24,7 +25,7 @@ bool cpuHasAvx2() {
 
 FastCode resolve(FastCode code) {
   if (code != FastCode::Best) return code;
-  return cpuHasAvx2() ? FastCode::Avx2 : FastCode::Portable;
+  return avx2Kernels() ? FastCode::Avx2 : FastCode::Portable;
 }
 
 // The widest vector any path reads past the end of a row of the suppression's copy.
@@ -32,7 +33,7 @@ constexpr int kMaxLanes = 32;
 
 }  // namespace
 
-bool fastCodeAvailable(FastCode code) { return code != FastCode::Avx2 || cpuHasAvx2(); }
+bool fastCodeAvailable(FastCode code) { return code != FastCode::Avx2 || avx2Kernels(); }
 
 bool fastScoreMapIsVectorised() { return resolve(FastCode::Best) != FastCode::Portable; }
 

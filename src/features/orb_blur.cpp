@@ -6,6 +6,8 @@
 
 #include "orbis/features/orb_extractor.hpp"
 
+#include "cpu_dispatch.hpp"
+
 #if defined(__SSE2__) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #define ORBIS_BLUR_AVX2 1
@@ -15,11 +17,6 @@ namespace orbis {
 namespace {
 
 #if defined(ORBIS_BLUR_AVX2)
-bool cpuHasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
-
 // The blur in integers, 16 pixels at a time: column sums of the 7 rows (at most 255 * 256, so
 // 16 bits), then row sums of those (32 bits), rounded half to even like sepFilter2D's fixed-point
 // path (docs/notes/2026-11-27-own-fast.md: equal on a million pixels, ties included). `src` has
@@ -89,7 +86,7 @@ void orbBlur(const cv::Mat& src, cv::Mat& dst) {
   // Inside a parent with 3 pixels of context (the pyramid's bordered levels), sepFilter2D reads
   // the parent's pixels, so the integer blur above gives its bits; elsewhere its reflection rules
   // apply and it runs itself.
-  if (cpuHasAvx2() && src.type() == CV_8UC1 && src.cols >= 16 && hasContext(src, 3) && src.data != dst.data) {
+  if (detail::cpuHasAvx2() && src.type() == CV_8UC1 && src.cols >= 16 && hasContext(src, 3) && src.data != dst.data) {
     dst.create(src.size(), CV_8UC1);
     thread_local std::vector<std::uint16_t> sums;
     sums.resize(static_cast<std::size_t>(src.cols) + 6);

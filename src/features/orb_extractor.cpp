@@ -18,6 +18,7 @@
 #define ORBIS_AVX2_DISPATCH 1
 #endif
 
+#include "cpu_dispatch.hpp"
 #include "orb_pattern.hpp"
 
 namespace orbis {
@@ -129,11 +130,6 @@ __attribute__((target("avx2"))) void rotatedOffsetsAvx2(float a, float b, int st
     _mm256_store_si256(reinterpret_cast<__m256i*>(offset + k), _mm256_add_epi32(_mm256_mullo_epi32(iy, vstep), ix));
   }
 }
-
-bool cpuHasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
 #endif
 
 // Rotated BRIEF: the pattern rotated by the keypoint angle, then 256 intensity comparisons.
@@ -142,7 +138,7 @@ void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDe
   const float a = std::cos(rad), b = std::sin(rad);
   alignas(32) int offset[2 * OrbDescriptor::kBits];
 #if defined(ORBIS_AVX2_DISPATCH)
-  if (cpuHasAvx2())
+  if (detail::cpuHasAvx2())
     rotatedOffsetsAvx2(a, b, step, offset);
   else
 #endif
