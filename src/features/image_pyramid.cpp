@@ -43,6 +43,7 @@ void ImagePyramid::allocate(cv::Size size0, const ScaleLevels& levels) {
   const auto n = static_cast<std::size_t>(levels.levels());
   bordered_.resize(n);
   interior_.resize(n);
+  resizers_.resize(n);
   for (std::size_t l = 0; l < n; ++l) {
     // At least one pixel, so tiny inputs give tiny levels rather than an OpenCV assertion.
     const cv::Size size(std::max(1, static_cast<int>(std::lround(size0.width * levels.invScale[l]))),
@@ -55,7 +56,7 @@ void ImagePyramid::allocate(cv::Size size0, const ScaleLevels& levels) {
 void ImagePyramid::buildLevel(int l) {
   CV_Assert(l >= 1 && l < levels());
   const auto i = static_cast<std::size_t>(l);
-  cv::resize(interior_[i - 1], interior_[i], interior_[i].size(), 0, 0, cv::INTER_LINEAR);
+  resizers_[i].resize(interior_[i - 1], interior_[i]);  // cv::resize's bits (linear_resize.hpp)
   fillBorder(bordered_[i], kBorder);
 }
 

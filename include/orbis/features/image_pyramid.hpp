@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "orbis/features/keypoint.hpp"
+#include "orbis/features/linear_resize.hpp"
 
 namespace orbis {
 
@@ -73,6 +74,7 @@ class ImagePyramid {
 
  private:
   std::vector<cv::Mat> bordered_, interior_;
+  std::vector<LinearResizer> resizers_;  // per level: each keeps its sizes' tables
 };
 
 }  // namespace orbis
