@@ -2,11 +2,11 @@
 #include "orbis/features/linear_resize.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
 #include "cpu_dispatch.hpp"
+#include "view_context.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -36,14 +36,6 @@ void linearTaps(int srcSize, int dstSize, bool clampAtEdges, std::vector<int>& o
     taps[2 * static_cast<std::size_t>(d)] = cv::saturate_cast<std::int16_t>((1.f - f) * 2048);
     taps[2 * static_cast<std::size_t>(d) + 1] = cv::saturate_cast<std::int16_t>(f * 2048);
   }
-}
-
-// Whether m is a view with at least `bytes` readable bytes after each row.
-bool readableAfterRows(const cv::Mat& m, int bytes) {
-  cv::Size whole;
-  cv::Point offset;
-  m.locateROI(whole, offset);
-  return whole.width - offset.x - m.cols >= bytes;
 }
 
 #if defined(ORBIS_RESIZE_AVX2)
@@ -92,8 +84,9 @@ void LinearResizer::prepare(cv::Size src, cv::Size dst) {
   for (auto& r : rows_) r.resize(static_cast<std::size_t>(dst.width));
   // Per group of 8 outputs (the last shifted back to end at the width): its first offset and the
   // shuffle that puts each output's two neighbours into a 16-bit pair, outputs 0-3 from the low
-  // copy of the 16 bytes and 4-7 from the high one. A group whose neighbours span more than 16
-  // bytes (a shrink by about 1.75 or more) leaves it to cv::resize.
+  // copy of the 16 bytes and 4-7 from the high one. Outputs narrower than 16 (the vertical pass's
+  // group) or a group whose neighbours span more than 16 bytes (a shrink by about 1.75 or more)
+  // leave the resize to cv::resize.
   const int groups = (dst.width + 7) / 8;
   groupFirst_.assign(static_cast<std::size_t>(groups), 0);
   groupMasks_.assign(32 * static_cast<std::size_t>(groups), 0x80);
@@ -105,7 +98,7 @@ void LinearResizer::prepare(cv::Size src, cv::Size dst) {
     for (int k = 0; k < 8; ++k) {
       const int rel = xOffsets_[static_cast<std::size_t>(at + k)] - first;
       if (rel < 0 || rel + 1 > 15) shuffleFits_ = false;
-      std::uint8_t* m = groupMasks_.data() + 32 * g + 4 * k;  // lane k / 4, byte 4 (k % 4) of it: k < 4 -> 4k, else 16 + 4(k - 4)
+      std::uint8_t* m = groupMasks_.data() + 32 * g + 4 * k;  // output k's pair: bytes 4k .. 4k + 3
       m[0] = static_cast<std::uint8_t>(rel);
       m[2] = static_cast<std::uint8_t>(rel + 1);
     }
@@ -126,9 +119,8 @@ const std::int16_t* LinearResizer::horizontalRow(const cv::Mat& src, int y, int 
   return rows_[s].data();
 }
 
-void LinearResizer::resizeWithOwnCode(const cv::Mat& src, cv::Mat& dst) {
+void LinearResizer::resizeWithOwnCode(const cv::Mat& src, cv::Mat& dst) {  // after prepare(), which fits
 #if defined(ORBIS_RESIZE_AVX2)
-  prepare(src.size(), dst.size());
   rowOf_[0] = rowOf_[1] = -1;  // a new source
   const int lastRow = src.rows - 1;
   for (int y = 0; y < dst.rows; ++y) {
@@ -174,7 +166,8 @@ bool LinearResizer::ownCodeAvailable() {
 
 void LinearResizer::resize(const cv::Mat& src, cv::Mat& dst) {
   CV_Assert(src.type() == CV_8UC1 && dst.type() == CV_8UC1 && !src.empty() && !dst.empty());
-  lastOwn_ = dst.cols >= 16 && readableAfterRows(src, 16) && src.data != dst.data && ownCodeAvailable();
+  // The groups' 16-byte loads read up to 15 bytes past a row's end.
+  lastOwn_ = detail::hasContext(src, 16) && ownCodeAvailable();
   if (lastOwn_) {
     prepare(src.size(), dst.size());
     lastOwn_ = shuffleFits_;

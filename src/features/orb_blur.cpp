@@ -7,6 +7,7 @@
 #include "orbis/features/orb_extractor.hpp"
 
 #include "cpu_dispatch.hpp"
+#include "view_context.hpp"
 
 #if defined(__SSE2__) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -70,15 +71,6 @@ __attribute__((target("avx2"))) void blurRowsAvx2(const std::uint8_t* src, std::
 }
 #endif
 
-// Whether `m` is a view with `margin` valid pixels of its parent on every side.
-bool hasContext(const cv::Mat& m, int margin) {
-  cv::Size whole;
-  cv::Point offset;
-  m.locateROI(whole, offset);
-  return offset.x >= margin && offset.y >= margin && whole.width - offset.x - m.cols >= margin &&
-         whole.height - offset.y - m.rows >= margin;
-}
-
 }  // namespace
 
 void orbBlur(const cv::Mat& src, cv::Mat& dst) {
@@ -86,7 +78,7 @@ void orbBlur(const cv::Mat& src, cv::Mat& dst) {
   // Inside a parent with 3 pixels of context (the pyramid's bordered levels), sepFilter2D reads
   // the parent's pixels, so the integer blur above gives its bits; elsewhere its reflection rules
   // apply and it runs itself.
-  if (detail::cpuHasAvx2() && src.type() == CV_8UC1 && src.cols >= 16 && hasContext(src, 3) && src.data != dst.data) {
+  if (detail::cpuHasAvx2() && src.type() == CV_8UC1 && src.cols >= 16 && detail::hasContext(src, 3) && src.data != dst.data) {
     dst.create(src.size(), CV_8UC1);
     thread_local std::vector<std::uint16_t> sums;
     sums.resize(static_cast<std::size_t>(src.cols) + 6);

@@ -4,9 +4,8 @@
 // Contract: LinearResizer::resize(src, dst) writes into dst (8-bit grey, already sized; may be a
 // view) exactly what cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_LINEAR) writes for an
 // 8-bit grey src. Its own code (AVX2) runs where the CPU has AVX2, dst is at least 16 pixels
-// wide, src is less than about 1.75 times dst's width (the pyramid's factor is 1.2) and has 16
-// readable bytes after every row (a view inside a larger image, as the pyramid's bordered
-// levels are), and only once a check at first use found it equal to this
+// wide, src is less than about 1.75 times dst's width (the pyramid's factor is 1.2) and is a view
+// with 16 pixels of its parent on every side (the pyramid's bordered levels have 19), and only once a check at first use found it equal to this
 // process's cv::resize on test images: OpenCV's fixed-point rounding is its build's, and any
 // other build keeps cv::resize. Everywhere else cv::resize runs. The coefficient tables for a
 // pair of sizes are kept between calls. One resizer per thread (the pyramid keeps one per
