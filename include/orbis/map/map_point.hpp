@@ -132,6 +132,12 @@ class MapPoint {
   std::uint64_t inLocalMapOf = 0, matchedIn = 0;
   // @}
 
+ private:
+  // Here, on the marks' cache line: tracking reads the three together for every local point.
+  bool bad_ = false;
+
+ public:
+
   // Recomputes the representative descriptor: the observation with least median distance to
   // the others.
   void computeDistinctiveDescriptor();
@@ -155,7 +161,6 @@ class MapPoint {
   ObservationList observations_;
   int observationCount_ = 0;
   int visible_ = 1, found_ = 1;
-  bool bad_ = false;
   MapPoint* replacedBy_ = nullptr;
 };
 

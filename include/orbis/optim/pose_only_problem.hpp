@@ -141,6 +141,17 @@ class PoseOnlyProblem {
     int i = 0;
     std::apply([&](const auto&... records) { ((i++ == term ? f(records) : void()), ...); }, records_);
   }
+  // hessian_ += JᵀJ on and above the diagonal, all solveDamped reads: each entry is the sum
+  // Problem forms for it (row products added in row order), half the products of the full block.
+  template <int Rows>
+  void addUpperGramian(const Eigen::Matrix<double, Rows, kPoseDim>& j) {
+    for (int c = 0; c < kPoseDim; ++c)
+      for (int r = 0; r <= c; ++r) {
+        double sum = j(0, r) * j(0, c);
+        for (int k = 1; k < Rows; ++k) sum = sum + j(k, r) * j(k, c);
+        hessian_(r, c) += sum;
+      }
+  }
   KernelValue kernel(double s, double delta2) const {
     return robust_ ? Kernel::evaluate(s, delta2) : TrivialKernel::evaluate(s, delta2);
   }
@@ -181,7 +192,7 @@ double PoseOnlyProblem<Kernel, Residuals...>::linearize() {
       const KernelValue k = kernel(s, rec.delta2);
       cost += 0.5 * k.rho;
       whitenAndCorrect(rec.information, k, s, r, &jPose);
-      hessian_.noalias() += jPose.transpose().lazyProduct(jPose);
+      addUpperGramian(jPose);
       gradient_.template segment<D>(0).noalias() -= jPose.transpose() * r;
     }
   });

@@ -216,6 +216,7 @@ class Tracker {
   int matchesInliers_ = 0;
   std::vector<KeyFrame*> localKeyFrames_;
   std::vector<MapPoint*> localPoints_;
+  std::vector<MapPoint*> pointSlots_;  // updateLocalMap's scratch, only grows
   bool recordKeypointStates_ = false;
   std::vector<KeypointState> keypointStates_;
   std::vector<std::unique_ptr<MapPoint>> temporaryStorage_;

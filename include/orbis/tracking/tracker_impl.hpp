@@ -426,13 +426,22 @@ void Tracker<Sensor>::updateLocalMap() {
   localKeyFrames_ = std::move(local);
   if (best) reference_ = best;
   // Their points, each once, in keyframe order.
-  localPoints_.clear();
+  // No branch on a point's fields: most are cache misses, and a mispredicted branch on one
+  // serialised them (docs/notes/2026-11-29-speed-tracking.md). Bad points get the stamp too,
+  // harmlessly: bad is final.
+  std::size_t slots = 0;
+  for (KeyFrame* kf : localKeyFrames_) slots += kf->points().size();
+  if (pointSlots_.size() < slots) pointSlots_.resize(slots);
+  std::size_t n = 0;
   for (KeyFrame* kf : localKeyFrames_)
-    for (MapPoint* p : kf->points())
-      if (p && !p->isBad() && p->inLocalMapOf != stamp) {
-        p->inLocalMapOf = stamp;
-        localPoints_.push_back(p);
-      }
+    for (MapPoint* p : kf->points()) {
+      if (!p) continue;
+      const bool fresh = !p->isBad() & (p->inLocalMapOf != stamp);
+      p->inLocalMapOf = stamp;
+      pointSlots_[n] = p;
+      n += fresh;
+    }
+  localPoints_.assign(pointSlots_.begin(), pointSlots_.begin() + static_cast<std::ptrdiff_t>(n));
 }
 
 template <SensorConfiguration Sensor>
@@ -470,8 +479,8 @@ int Tracker<Sensor>::searchLocalPoints() {
 
 template <SensorConfiguration Sensor>
 bool Tracker<Sensor>::trackLocalMap() {
-  updateLocalMap();
-  const int found = searchLocalPoints();
+  { ScopedStage stage(timer_, "tracking: TMP update"); updateLocalMap(); }
+  int found; { ScopedStage stage(timer_, "tracking: TMP search"); found = searchLocalPoints(); }
   note("local_keyframes", static_cast<double>(localKeyFrames_.size()));
   note("local_points", static_cast<double>(localPoints_.size()));
   note("local_matches", found);
