@@ -7,13 +7,19 @@
 // Kernel>...> returns with the same pose free and every point fixed: each sum is formed over the
 // same terms in the same order with the same expressions, and the damped system is factorised by
 // the same dynamic-size LLT. setRobust(false) evaluates TrivialKernel instead of Kernel (the
-// rounds "without kernel"). Why it exists: Problem rebuilds its block structure, maps over every
-// point and copies them for each solve (four per frame); at a pose and ~300 fixed points that
-// overhead is a large share of the solve. Not thread-safe.
+// rounds "without kernel"). Pinhole reprojection residuals under Huber or no kernel are evaluated
+// four at a time where the CPU has AVX2 (pinhole_pose_kernel.hpp), with the same bits. Why it
+// exists: Problem rebuilds its block structure, maps over every point and copies them for each
+// solve (four per frame); at a pose and ~300 fixed points that overhead is a large share of the
+// solve. Not thread-safe.
 #pragma once
 
+#include "orbis/camera/pinhole.hpp"
 #include "orbis/optim/levenberg_marquardt.hpp"
+#include "orbis/optim/pinhole_pose_kernel.hpp"
+#include "orbis/optim/reprojection.hpp"
 #include "orbis/optim/residual.hpp"
+#include "orbis/optim/robust_kernel.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -62,6 +68,7 @@ class PoseOnlyProblem {
     static_assert(term >= 0, "residual type is not one of the problem's");
     auto& records = std::get<term>(records_);
     records.push_back(ResidualRecord<R>{residual, 0, point, information, delta2, true});
+    pinholeValid_ = false;
     return {term, static_cast<int>(records.size()) - 1};
   }
   // @{
@@ -73,7 +80,10 @@ class PoseOnlyProblem {
   void setRobust(bool robust) { robust_ = robust; }
   // Switches a residual on or off (outliers are switched off).
   void setActive(ResidualId id, bool active) {
-    visitTerm(id.term, [&](auto& records) { records[id.index].active = active; });
+    visitTerm(id.term, [&](auto& records) {
+      if (records[id.index].active != active) pinholeValid_ = false;
+      records[id.index].active = active;
+    });
   }
   // information·‖r‖² at the current pose.
   double chi2(ResidualId id) const {
@@ -128,10 +138,6 @@ class PoseOnlyProblem {
     return termOfImpl<R>(std::index_sequence_for<Residuals...>{});
   }
   template <class F>
-  void forEachRecords(F&& f) const {
-    std::apply([&](const auto&... records) { (f(records), ...); }, records_);
-  }
-  template <class F>
   void visitTerm(int term, F&& f) {
     int i = 0;
     std::apply([&](auto&... records) { ((i++ == term ? f(records) : void()), ...); }, records_);
@@ -152,6 +158,53 @@ class PoseOnlyProblem {
         hessian_(r, c) += sum;
       }
   }
+  // Each term's records with the term's index: f.template operator()<I>(records).
+  template <class F>
+  void forEachTerm(F&& f) const {
+    [&]<std::size_t... I>(std::index_sequence<I...>) {
+      (f.template operator()<static_cast<int>(I)>(std::get<I>(records_)), ...);
+    }(std::index_sequence_for<Residuals...>{});
+  }
+
+  // ---- Pinhole reprojection residuals four at a time (pinhole_pose_kernel.hpp) ----
+  // The term they are, if any, and whether this kernel is one the four-at-a-time code evaluates.
+  static constexpr int pinholeTerm() { return std::is_same_v<PoseM, SE3Manifold> ? termOf<MonoReprojection>() : -1; }
+  bool pinholeHuber() const { return robust_ && std::is_same_v<Kernel, HuberKernel>; }
+  bool pinholeKernelFits() const {
+    return !robust_ || std::is_same_v<Kernel, HuberKernel> || std::is_same_v<Kernel, TrivialKernel>;
+  }
+  // Whether linearize() and candidateCost() take the term's active residuals four at a time;
+  // (re)builds their arrays after add() or setActive() changed them.
+  bool pinholeReady() {
+    if constexpr (pinholeTerm() < 0) {
+      return false;
+    } else {
+      if (!pinholeKernelFits() || !detail::pinholePoseKernelAvailable()) return false;
+      if (!pinholeValid_) {
+        pinholeValid_ = true;
+        pinhole_.clear();
+        pinholeCamera_ = nullptr;
+        pinholeUsable_ = true;
+        const auto& records = std::get<static_cast<std::size_t>(pinholeTerm())>(records_);
+        for (std::size_t e = 0; e < records.size(); ++e) {
+          const auto& rec = records[e];
+          if (!rec.active) continue;
+          if (pinholeCamera_ && rec.residual.camera != pinholeCamera_) pinholeUsable_ = false;  // one camera only
+          pinholeCamera_ = rec.residual.camera;
+          pinhole_.push(points_[static_cast<std::size_t>(rec.other)].data(), rec.residual.measurement.data(),
+                        rec.information, rec.delta2, static_cast<int>(e));
+        }
+      }
+      return pinholeUsable_ && pinholeCamera_ != nullptr;
+    }
+  }
+  detail::PinholePose pinholePose(const Pose& pose) const {
+    const auto& q = pose.unitQuaternion();
+    const auto& t = pose.translation();
+    return {{q.x(), q.y(), q.z(), q.w()}, {t.x(), t.y(), t.z()},
+            pinholeCamera_->fx, pinholeCamera_->fy, pinholeCamera_->cx, pinholeCamera_->cy};
+  }
+
   KernelValue kernel(double s, double delta2) const {
     return robust_ ? Kernel::evaluate(s, delta2) : TrivialKernel::evaluate(s, delta2);
   }
@@ -166,6 +219,9 @@ class PoseOnlyProblem {
   std::span<const Eigen::Vector3d> points_;
   std::tuple<AlignedVector<ResidualRecord<Residuals>>...> records_;
   bool robust_ = true;
+  detail::PinholeResiduals pinhole_;
+  const PinholeCamera<double>* pinholeCamera_ = nullptr;
+  bool pinholeValid_ = false, pinholeUsable_ = false;
   PoseBlock hessian_;
   // Dynamic-size like Problem's pose vectors and reduced system, so that every reduction and the
   // factorisation take the same code path (a fixed-size dot product sums in another order).
@@ -181,8 +237,17 @@ double PoseOnlyProblem<Kernel, Residuals...>::linearize() {
   hessian_.setZero();
   gradient_.setZero();
   double cost = 0.0;
-  forEachRecords([&](const auto& records) {
-    for (const auto& rec : records) {
+  forEachTerm([&]<int I>(const auto& records) {
+    std::size_t first = 0;  // records before it were taken four at a time
+    if constexpr (I == pinholeTerm()) {
+      if (pinholeReady()) {
+        const std::size_t taken = detail::linearizePinholeBlocks(pinholePose(pose_), pinhole_, pinholeHuber(), cost,
+                                                                 hessian_.data(), gradient_.data());
+        first = taken == 0 ? 0 : static_cast<std::size_t>(pinhole_.record[taken - 1]) + 1;
+      }
+    }
+    for (std::size_t e = first; e < records.size(); ++e) {
+      const auto& rec = records[e];
       using R = std::decay_t<decltype(rec.residual)>;
       if (!rec.active) continue;
       ResidualVector<R> r;
@@ -228,8 +293,16 @@ template <RobustKernel Kernel, PointResidual... Residuals>
 double PoseOnlyProblem<Kernel, Residuals...>::candidateCost() {
   candidate_ = PoseM::plus(pose_, step_.template segment<kPoseDim>(0));
   double cost = 0.0;
-  forEachRecords([&](const auto& records) {
-    for (const auto& rec : records) {
+  forEachTerm([&]<int I>(const auto& records) {
+    std::size_t first = 0;
+    if constexpr (I == pinholeTerm()) {
+      if (pinholeReady()) {
+        const std::size_t taken = detail::costPinholeBlocks(pinholePose(candidate_), pinhole_, pinholeHuber(), cost);
+        first = taken == 0 ? 0 : static_cast<std::size_t>(pinhole_.record[taken - 1]) + 1;
+      }
+    }
+    for (std::size_t e = first; e < records.size(); ++e) {
+      const auto& rec = records[e];
       if (!rec.active) continue;
       const double s = rec.information * rawResidual(rec, candidate_).squaredNorm();
       cost += 0.5 * kernel(s, rec.delta2).rho;
