@@ -53,10 +53,10 @@ class FeatureGrid {
     }
   }
 
-  // Appends the keypoints within radius r of (u, v) whose level lies in [minLevel, maxLevel] (−1:
-  // any).
-  void featuresInArea(float u, float v, float r, int minLevel, int maxLevel, std::vector<int>& out) const {
-    out.clear();
+  // Calls visit(index, octave) for each keypoint within radius r of (u, v) whose level lies in
+  // [minLevel, maxLevel] (−1: any), in cell order: featuresInArea without the list.
+  template <class Visit>
+  void forEachInArea(float u, float v, float r, int minLevel, int maxLevel, Visit&& visit) const {
     if (entries_.empty()) return;
     const int c0 = std::max(0, static_cast<int>(std::floor((u - r - minX_) * invCellW_)));
     const int c1 = std::min(kCols - 1, static_cast<int>(std::floor((u + r - minX_) * invCellW_)));
@@ -69,10 +69,17 @@ class FeatureGrid {
           const Entry& k = entries_[static_cast<std::size_t>(e)];
           if (minLevel >= 0 && k.octave < minLevel) continue;
           if (maxLevel >= 0 && k.octave > maxLevel) continue;
-          if (std::abs(k.u - u) < r && std::abs(k.v - v) < r) out.push_back(k.index);
+          if (std::abs(k.u - u) < r && std::abs(k.v - v) < r) visit(k.index, k.octave);
         }
       }
     }
+  }
+
+  // Appends the keypoints within radius r of (u, v) whose level lies in [minLevel, maxLevel] (−1:
+  // any).
+  void featuresInArea(float u, float v, float r, int minLevel, int maxLevel, std::vector<int>& out) const {
+    out.clear();
+    forEachInArea(u, v, r, minLevel, maxLevel, [&](int index, int) { out.push_back(index); });
   }
 
   // The keypoints within radius r of (u, v) whose level lies in [minLevel, maxLevel] (−1: any).

@@ -89,6 +89,19 @@ struct NearestTwo {
   // Levels of the best and second-best (−1 for none).
   int bestOctave = -1, secondOctave = -1;  // -1 for none
   // @}
+  // Takes keypoint `index` (level `octave`) at distance d; a tie keeps the earlier one.
+  void offer(int d, int octave, long index) {
+    if (d < bestDistance) {
+      secondDistance = bestDistance;
+      secondOctave = bestOctave;
+      bestDistance = d;
+      bestOctave = octave;
+      best = index;
+    } else if (d < secondDistance) {
+      secondDistance = d;
+      secondOctave = octave;
+    }
+  }
 };
 
 // The nearest and second-nearest keypoints of `features` to `query` among `candidates`
@@ -102,18 +115,23 @@ NearestTwo nearestTwo(const FrameFeatures& features, const OrbDescriptor& query,
   for (const auto candidate : candidates) {
     const auto i = static_cast<std::size_t>(candidate);
     if (skip(i)) continue;
-    const int d = distance(query, features.descriptors[i]);
-    if (d < n.bestDistance) {
-      n.secondDistance = n.bestDistance;
-      n.secondOctave = n.bestOctave;
-      n.bestDistance = d;
-      n.bestOctave = features.keypointsUn[i].octave;
-      n.best = static_cast<long>(i);
-    } else if (d < n.secondDistance) {
-      n.secondDistance = d;
-      n.secondOctave = features.keypointsUn[i].octave;
-    }
+    n.offer(distance(query, features.descriptors[i]), features.keypointsUn[i].octave, static_cast<long>(i));
   }
+  return n;
+}
+
+// nearestTwo over the grid window FeatureGrid::featuresInArea(u, v, r, minLevel, maxLevel) would
+// list, visited in the same order, without listing it.
+template <class Skip, class Distance = HammingDistance>
+  requires DescriptorDistance<Distance, OrbDescriptor>
+NearestTwo nearestTwoInArea(const FrameFeatures& features, const OrbDescriptor& query, float u, float v, float r,
+                            int minLevel, int maxLevel, Skip&& skip, const Distance& distance = {}) {
+  NearestTwo n;
+  features.grid.forEachInArea(u, v, r, minLevel, maxLevel, [&](int index, int octave) {
+    const auto i = static_cast<std::size_t>(index);
+    if (skip(i)) return;
+    n.offer(distance(query, features.descriptors[i]), octave, static_cast<long>(i));
+  });
   return n;
 }
 
@@ -170,7 +188,6 @@ int searchByProjection(const FrameFeatures& frame, std::span<const ProjectionQue
                        const Distance& distance = {}) {
   matches.assign(queries.size(), -1);
   std::vector<std::uint8_t> used = detail::takenMask(taken, frame.size());
-  std::vector<int> candidates;
   int count = 0;
   for (std::size_t q = 0; q < queries.size(); ++q) {
     const ProjectionQuery& query = queries[q];
@@ -178,9 +195,8 @@ int searchByProjection(const FrameFeatures& frame, std::span<const ProjectionQue
     // Viewing almost along the mean direction: appearance is reliable, search tighter.
     const float base = query.viewCos > 0.998f ? 2.5f : 4.f;
     const float r = base * th * frame.scales.scale[static_cast<std::size_t>(level)] * query.windowStretch;
-    frame.grid.featuresInArea(query.u, query.v, r, level - 1, level, candidates);
-    const NearestTwo n = nearestTwo(
-        frame, query.descriptor, candidates,
+    const NearestTwo n = nearestTwoInArea(
+        frame, query.descriptor, query.u, query.v, r, level - 1, level,
         [&](std::size_t i) { return used[i] || rightCoordinateDisagrees(query.uRight, frame.uRight[i], r); }, distance);
     if (n.best < 0 || n.bestDistance > matching::kThHigh) continue;
     if (n.bestOctave == n.secondOctave &&

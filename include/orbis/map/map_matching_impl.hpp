@@ -85,7 +85,6 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
   if constexpr (kStereo) baseline = current.camera->bf() / pinholeOf(*current.camera).fx;
   const bool forward = kStereo && tlc.z() > baseline;
   const bool backward = kStereo && -tlc.z() > baseline;
-  std::vector<int> candidates;
   int matches = 0;
   for (std::size_t i = 0; i < last.size(); ++i) {
     MapPoint* p = last.points[i];
@@ -101,10 +100,9 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
     int minLevel = lastOctave - 1, maxLevel = lastOctave + 1;
     if (forward) { minLevel = lastOctave; maxLevel = levels.levels() - 1; }
     else if (backward) { minLevel = 0; maxLevel = lastOctave; }
-    cf.grid.featuresInArea(u, v, r, std::max(0, minLevel), maxLevel, candidates);
     const float uRightPred = static_cast<float>(obs.z());
     // A stereo prediction is checked even when negative (a point nearer than the baseline).
-    const NearestTwo n = nearestTwo(cf, p->descriptor(), candidates, [&](std::size_t j) {
+    const NearestTwo n = nearestTwoInArea(cf, p->descriptor(), u, v, r, std::max(0, minLevel), maxLevel, [&](std::size_t j) {
       return detail::matchedToMapPoint(current.points[j]) ||
              (kStereo && cf.uRight[j] >= 0 && std::abs(uRightPred - cf.uRight[j]) > r);
     });
