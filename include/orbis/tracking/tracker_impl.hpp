@@ -479,8 +479,15 @@ int Tracker<Sensor>::searchLocalPoints() {
 
 template <SensorConfiguration Sensor>
 bool Tracker<Sensor>::trackLocalMap() {
-  { ScopedStage stage(timer_, "tracking: TMP update"); updateLocalMap(); }
-  int found; { ScopedStage stage(timer_, "tracking: TMP search"); found = searchLocalPoints(); }
+  {
+    ScopedStage stage(timer_, "tracking: local map update");
+    updateLocalMap();
+  }
+  int found = 0;
+  {
+    ScopedStage stage(timer_, "tracking: local map search");
+    found = searchLocalPoints();
+  }
   note("local_keyframes", static_cast<double>(localKeyFrames_.size()));
   note("local_points", static_cast<double>(localPoints_.size()));
   note("local_matches", found);
