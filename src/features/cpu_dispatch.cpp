@@ -12,4 +12,13 @@ bool cpuHasAvx2() {
 #endif
 }
 
+bool cpuHasAvx512bw() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool has = __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512f");
+  return has;
+#else
+  return false;
+#endif
+}
+
 }  // namespace orbis::detail

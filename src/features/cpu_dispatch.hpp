@@ -8,4 +8,7 @@ namespace orbis::detail {
 // Whether this CPU (and OS) runs AVX2; false where the check is not available. Cached.
 bool cpuHasAvx2();
 
+// Whether this CPU (and OS) runs AVX-512 with byte and word operations (AVX-512BW); cached.
+bool cpuHasAvx512bw();
+
 }  // namespace orbis::detail

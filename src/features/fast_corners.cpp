@@ -23,8 +23,18 @@ bool avx2Kernels() {
 #endif
 }
 
+// Whether the AVX-512BW score kernel is both built and runnable here.
+bool avx512Kernels() {
+#if defined(ORBIS_HAVE_AVX512_KERNELS)
+  return avx2Kernels() && detail::cpuHasAvx512bw();
+#else
+  return false;
+#endif
+}
+
 FastCode resolve(FastCode code) {
   if (code != FastCode::Best) return code;
+  if (avx512Kernels()) return FastCode::Avx512;
   return avx2Kernels() ? FastCode::Avx2 : FastCode::Portable;
 }
 
@@ -33,7 +43,13 @@ constexpr int kMaxLanes = 32;
 
 }  // namespace
 
-bool fastCodeAvailable(FastCode code) { return code != FastCode::Avx2 || avx2Kernels(); }
+bool fastCodeAvailable(FastCode code) {
+  switch (code) {
+    case FastCode::Avx2: return avx2Kernels();
+    case FastCode::Avx512: return avx512Kernels();
+    default: return true;
+  }
+}
 
 bool fastScoreMapIsVectorised() { return resolve(FastCode::Best) != FastCode::Portable; }
 
@@ -46,6 +62,12 @@ void fastScoreMap(const cv::Mat& image, const cv::Rect& area, int threshold, cv:
   const std::uint8_t* origin = image.ptr<std::uint8_t>(area.y) + area.x;
   const auto stride = static_cast<std::ptrdiff_t>(image.step1());
   const auto scoreStride = static_cast<std::ptrdiff_t>(scores.step1());
+#if defined(ORBIS_HAVE_AVX512_KERNELS)
+  if (resolve(code) == FastCode::Avx512) {
+    detail::fastScoreRowsAvx512(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
+    return;
+  }
+#endif
 #if defined(ORBIS_HAVE_AVX2_KERNELS)
   if (resolve(code) == FastCode::Avx2) {
     detail::fastScoreRowsAvx2(origin, stride, area.width, area.height, threshold, scores.data, scoreStride);
@@ -75,7 +97,9 @@ void fastCornersOfScoreMap(const cv::Mat& scores, const cv::Rect& area, int thre
     std::memset(row + area.width, 0, static_cast<std::size_t>(stride - area.width));  // and the next lead
   }
   std::memset(padded.data() + (area.height + 1) * stride + lead, 0, static_cast<std::size_t>(stride - lead));
-  const bool avx2 = resolve(code) == FastCode::Avx2;
+  // No 64-lane suppression: AVX-512 score maps are suppressed by the AVX2 code, which was
+  // faster than a 64-lane version (docs/notes/2026-11-29-speed-extraction-vectors.md).
+  const bool avx2 = resolve(code) != FastCode::Portable;
   const int lanes = avx2 ? 32 : 1;
   scratch.words.resize(static_cast<std::size_t>((width + lanes - 1) / lanes));
   std::uint32_t* bits = scratch.words.data();

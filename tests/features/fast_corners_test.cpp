@@ -1,4 +1,4 @@
-// FAST score-map tests: every code path (portable, AVX2 where the CPU has it) against cv::FAST on
+// FAST score-map tests: every code path (portable, AVX2 and AVX-512 where the CPU has them) against cv::FAST on
 // whole images and on sub-areas of a lower-threshold map, as OrbExtractor reads them.
 #include <gtest/gtest.h>
 
@@ -45,6 +45,7 @@ std::vector<CornerTuple> mapCorners(const cv::Mat& image, const cv::Rect& mapAre
 std::vector<FastCode> availableCodes() {
   std::vector<FastCode> codes{FastCode::Portable};
   if (fastCodeAvailable(FastCode::Avx2)) codes.push_back(FastCode::Avx2);
+  if (fastCodeAvailable(FastCode::Avx512)) codes.push_back(FastCode::Avx512);
   return codes;
 }
 
@@ -104,15 +105,18 @@ TEST(FastCorners, SubAreasOfALowerThresholdMapMatchOpenCvOnThoseAreas) {
 }
 
 TEST(FastCorners, VectorCodeWritesThePortableScores) {
-  if (!fastCodeAvailable(FastCode::Avx2)) GTEST_SKIP() << "no AVX2 on this CPU";
+  const auto codes = availableCodes();
+  if (codes.size() == 1) GTEST_SKIP() << "no vector code on this CPU";
   for (const cv::Mat& image : testImages())
-    for (const int width : {image.cols - 6, 40, 31, 16, 9}) {
-      const cv::Rect area(3, 3, width, image.rows - 6);
-      cv::Mat portable, vector;
-      fastScoreMap(image, area, 7, portable, FastCode::Portable);
-      fastScoreMap(image, area, 7, vector, FastCode::Avx2);
-      EXPECT_EQ(cv::norm(portable, vector, cv::NORM_INF), 0.0) << "width " << width;
-    }
+    for (const int width : {image.cols - 6, 130, 64, 63, 40, 31, 16, 9})
+      for (const FastCode code : codes) {
+        if (width > image.cols - 6) continue;
+        const cv::Rect area(3, 3, width, image.rows - 6);
+        cv::Mat portable, vector;
+        fastScoreMap(image, area, 7, portable, FastCode::Portable);
+        fastScoreMap(image, area, 7, vector, code);
+        EXPECT_EQ(cv::norm(portable, vector, cv::NORM_INF), 0.0) << "code " << static_cast<int>(code) << ", width " << width;
+      }
 }
 
 TEST(FastCorners, RejectsAreasWithoutTheCircleContext) {

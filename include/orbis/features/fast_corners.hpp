@@ -10,9 +10,9 @@
 // whose score is at least `threshold` (not below the map's) and larger than each of their eight
 // neighbours inside the sub-area (outside counts as 0) — exactly what cv::FAST reports for the
 // image cropped to that sub-area plus 3 pixels — keeping those left of `keepBelowX` (map
-// columns). The code is picked once at run time: AVX2 where the CPU has it, else portable
-// one-pixel-at-a-time code (correct, but slower than cv::FAST: OrbExtractor uses cv::FAST
-// there). Every path gives the same output. Thread-safe; the buffers are the caller's.
+// columns). The code is picked once at run time: AVX-512BW scores (with AVX2 suppression) or AVX2
+// where the CPU has them, else portable one-pixel-at-a-time code (correct, but slower than
+// cv::FAST: OrbExtractor uses cv::FAST there). Every path gives the same output. Thread-safe; the buffers are the caller's.
 // Design and measurements: docs/notes/2026-11-27-own-fast.md.
 #pragma once
 
@@ -37,7 +37,7 @@ struct FastScratch {
 };
 
 // Which code computes the map and its corners: the best this CPU runs, or one forced (tests).
-enum class FastCode { Best, Portable, Avx2 };
+enum class FastCode { Best, Portable, Avx2, Avx512 };
 
 // Whether this build and CPU can run `code`; FastCode::Best is always available.
 bool fastCodeAvailable(FastCode code);
