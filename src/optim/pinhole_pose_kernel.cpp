@@ -1,10 +1,19 @@
-// The run-time choice of motion-only BA's AVX2 pinhole code (contract in
-// orbis/optim/pinhole_pose_kernel.hpp); without it both entry points take nothing.
+// The run-time choice of motion-only BA's vector pinhole code (contract in
+// orbis/optim/pinhole_pose_kernel.hpp): eight lanes (AVX-512F) or four (AVX2) where built and
+// run by this CPU; otherwise the entry points take nothing.
 #include "orbis/optim/pinhole_pose_kernel.hpp"
 
 namespace orbis::optim::detail {
 
-bool pinholePoseKernelAvailable() {
+// The units' entry points (pinhole_pose_kernel_avx2.cpp, pinhole_pose_kernel_avx512.cpp).
+std::size_t linearizePinholeBlocksAvx2(const PinholePose&, const PinholeResiduals&, bool, double&, double*, double*);
+std::size_t costPinholeBlocksAvx2(const PinholePose&, const PinholeResiduals&, bool, double&);
+std::size_t linearizePinholeBlocksAvx512(const PinholePose&, const PinholeResiduals&, bool, double&, double*, double*);
+std::size_t costPinholeBlocksAvx512(const PinholePose&, const PinholeResiduals&, bool, double&);
+
+namespace {
+
+bool cpuSupports4() {
 #if defined(ORBIS_HAVE_AVX2_KERNELS) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   static const bool has = __builtin_cpu_supports("avx2");
   return has;
@@ -13,11 +22,56 @@ bool pinholePoseKernelAvailable() {
 #endif
 }
 
-#if !defined(ORBIS_HAVE_AVX2_KERNELS)
-std::size_t linearizePinholeBlocks(const PinholePose&, const PinholeResiduals&, bool, double&, double*, double*) {
-  return 0;
-}
-std::size_t costPinholeBlocks(const PinholePose&, const PinholeResiduals&, bool, double&) { return 0; }
+bool cpuSupports8() {
+#if defined(ORBIS_HAVE_AVX512_KERNELS) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool has = __builtin_cpu_supports("avx512f");
+  return has;
+#else
+  return false;
 #endif
+}
+
+// The lanes a call runs with: `lanes` if available, the widest available for 0, else none.
+int resolveLanes(int lanes) {
+  if (lanes == 0) return cpuSupports8() ? 8 : cpuSupports4() ? 4 : 0;
+  return pinholePoseKernelAvailable(lanes) ? lanes : 0;
+}
+
+}  // namespace
+
+bool pinholePoseKernelAvailable(int lanes) {
+  switch (lanes) {
+    case 0: return cpuSupports8() || cpuSupports4();
+    case 4: return cpuSupports4();
+    case 8: return cpuSupports8();
+    default: return false;
+  }
+}
+
+std::size_t linearizePinholeBlocks(const PinholePose& pose, const PinholeResiduals& residuals, bool huber,
+                                   double& cost, double* hessian, double* gradient, int lanes) {
+  switch (resolveLanes(lanes)) {
+#if defined(ORBIS_HAVE_AVX512_KERNELS)
+    case 8: return linearizePinholeBlocksAvx512(pose, residuals, huber, cost, hessian, gradient);
+#endif
+#if defined(ORBIS_HAVE_AVX2_KERNELS)
+    case 4: return linearizePinholeBlocksAvx2(pose, residuals, huber, cost, hessian, gradient);
+#endif
+    default: return 0;
+  }
+}
+
+std::size_t costPinholeBlocks(const PinholePose& pose, const PinholeResiduals& residuals, bool huber, double& cost,
+                              int lanes) {
+  switch (resolveLanes(lanes)) {
+#if defined(ORBIS_HAVE_AVX512_KERNELS)
+    case 8: return costPinholeBlocksAvx512(pose, residuals, huber, cost);
+#endif
+#if defined(ORBIS_HAVE_AVX2_KERNELS)
+    case 4: return costPinholeBlocksAvx2(pose, residuals, huber, cost);
+#endif
+    default: return 0;
+  }
+}
 
 }  // namespace orbis::optim::detail

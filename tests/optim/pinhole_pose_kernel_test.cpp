@@ -1,4 +1,4 @@
-// The four-at-a-time pinhole residuals against the one-at-a-time code they replace (the
+// The vector (four- and eight-lane) pinhole residuals against the one-at-a-time code they replace (the
 // reprojection residual, the kernel, whitenAndCorrect and PoseOnlyProblem's sums): the same bits
 // for the cost, JᵀJ's upper triangle and the gradient, under Huber (both sides of δ) and no
 // kernel, for every count (the remainder is the caller's).
@@ -46,8 +46,11 @@ bool sameBits(const Sums& a, const Sums& b) {
          std::memcmp(a.gradient.data(), b.gradient.data(), sizeof(double) * 6) == 0;
 }
 
-TEST(PinholePoseKernel, GivesTheOneAtATimeBits) {
-  if (!detail::pinholePoseKernelAvailable()) GTEST_SKIP() << "no AVX2 build or CPU";
+class PinholePoseKernel : public ::testing::TestWithParam<int> {};
+
+TEST_P(PinholePoseKernel, GivesTheOneAtATimeBits) {
+  const int lanes = GetParam();
+  if (!detail::pinholePoseKernelAvailable(lanes)) GTEST_SKIP() << "no " << lanes << "-lane build or CPU";
   PinholeCamera<double> camera;
   camera.fx = 535.4;
   camera.fy = 539.2;
@@ -70,19 +73,19 @@ TEST(PinholePoseKernel, GivesTheOneAtATimeBits) {
       in.push(pw.data(), px.data(), 1.0 / (1.0 + static_cast<double>(k % 5)), 5.991, static_cast<int>(k));
     }
     for (const bool huber : {true, false}) {
-      Sums four, one;
-      const std::size_t taken = detail::linearizePinholeBlocks(p, in, huber, four.cost, four.hessian.data(),
-                                                               four.gradient.data());
-      ASSERT_EQ(taken, n / 4 * 4);
+      Sums vector, one;
+      const std::size_t taken = detail::linearizePinholeBlocks(p, in, huber, vector.cost, vector.hessian.data(),
+                                                               vector.gradient.data(), lanes);
+      ASSERT_EQ(taken, n / static_cast<std::size_t>(lanes) * static_cast<std::size_t>(lanes));
       for (std::size_t k = 0; k < taken; ++k) {
         addOne(pose, camera, in, k, huber, one);
         const Eigen::Vector2d r = camera.project(pose * Eigen::Vector3d(in.x[k], in.y[k], in.z[k])) -
                                   Eigen::Vector2d(in.u[k], in.v[k]);
         outside += huber && in.information[k] * r.squaredNorm() > in.delta2[k];
       }
-      EXPECT_TRUE(sameBits(four, one)) << n << " residuals, huber " << huber;
+      EXPECT_TRUE(sameBits(vector, one)) << n << " residuals, huber " << huber;
       double costOnly = 0.0;
-      EXPECT_EQ(detail::costPinholeBlocks(p, in, huber, costOnly), taken);
+      EXPECT_EQ(detail::costPinholeBlocks(p, in, huber, costOnly, lanes), taken);
       EXPECT_EQ(std::memcmp(&costOnly, &one.cost, sizeof(double)), 0) << n << " residuals, huber " << huber;
       ++compared;
     }
@@ -90,6 +93,8 @@ TEST(PinholePoseKernel, GivesTheOneAtATimeBits) {
   EXPECT_GT(outside, 50);  // Huber's linear side was exercised
   EXPECT_EQ(compared, 84);
 }
+
+INSTANTIATE_TEST_SUITE_P(Lanes, PinholePoseKernel, ::testing::Values(4, 8));
 
 }  // namespace
 }  // namespace orbis::optim
