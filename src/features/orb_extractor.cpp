@@ -152,13 +152,6 @@ void briefDescriptor(const std::uint8_t* center, int step, float angleDeg, OrbDe
   }
 }
 
-// A rows x cols 8-bit image over `buffer`, grown when too small (the largest level sets its size).
-cv::Mat viewOfBuffer(std::vector<std::uint8_t>& buffer, int rows, int cols) {
-  const auto bytes = static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols);
-  if (buffer.size() < bytes) buffer.resize(bytes);
-  return cv::Mat(rows, cols, CV_8UC1, buffer.data());
-}
-
 }  // namespace
 
 OrbExtractor::OrbExtractor(const OrbParams& params)
@@ -178,6 +171,7 @@ OrbExtractor::OrbExtractor(const OrbParams& params)
     perLevel *= factor;
   }
   featuresPerLevel_[static_cast<std::size_t>(n - 1)] = std::max(params.features - assigned, 0);
+  blurred_.resize(static_cast<std::size_t>(n));
 
   // Half-width of each row of the orientation circle, made symmetric under swapping u and v so
   // the moments do not favour an axis.
@@ -215,11 +209,9 @@ void OrbExtractor::detectCorners(const cv::Mat& level, LevelScratch& s) const {
   // them, the same corners as cv::FAST's over the same widened areas
   // (docs/notes/2026-11-27-own-fast.md).
   const bool scoreMap = !openCvFast_;
-  if (scoreMap) {
-    const cv::Rect area(minX, minY, level.cols - 3 - minX, maxY - minY);
-    s.fastScores = viewOfBuffer(s.fastScoreBuffer, area.height, area.width);
-    fastScoreMap(level, area, std::min(params_.iniThFast, params_.minThFast), s.fastScores);
-  }
+  if (scoreMap)
+    fastScoreMap(level, cv::Rect(minX, minY, level.cols - 3 - minX, maxY - minY),
+                 std::min(params_.iniThFast, params_.minThFast), s.fastScores);
   auto fastIn = [&](int x0, int y0, int x1, int y1, int threshold) {
     const int padded = std::min(((x1 - x0 + 14) / 16) * 16 + 1, level.cols - 3 - x0);  // >= x1 - x0: x1 <= cols - kEdge
     if (scoreMap) {
@@ -554,7 +546,8 @@ void OrbExtractor::extractLevel(int l, LevelScratch& s) {
 
   // Pattern points lie within 18.4 px of the keypoint, which is kEdge (19) px inside, so
   // the tests read only the interior; the blur there reads the reflected border as context.
-  const cv::Mat blurred = viewOfBuffer(s.blurBuffer, level.rows + 2 * b, level.cols + 2 * b);
+  cv::Mat& blurred = blurred_[static_cast<std::size_t>(l)];
+  blurred.create(level.rows + 2 * b, level.cols + 2 * b, CV_8UC1);
   cv::Mat target = blurred(cv::Rect(b, b, level.cols, level.rows));
   orbBlur(level, target);
 

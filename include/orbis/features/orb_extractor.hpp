@@ -102,11 +102,7 @@ class OrbExtractor : public PyramidExtractorBase {
   // The buffers one level's detection and selection reuse; one per thread working on levels.
   struct LevelScratch {
     std::vector<cv::KeyPoint> fast;
-    // A level's FAST score map (fast_corners.hpp, where vectorised) and its blurred image live
-    // in buffers sized for the largest level and reused by every level this thread extracts, so
-    // that they stay in cache rather than each level's being faulted in or fetched for writing.
-    std::vector<std::uint8_t> fastScoreBuffer, blurBuffer;
-    cv::Mat fastScores;  // a view into fastScoreBuffer
+    cv::Mat fastScores;  // the level's FAST score map (fast_corners.hpp), where vectorised
     FastScratch fastScratch;
     std::vector<FastCorner> fastCorners;
     std::vector<Corner> corners, sorted;
@@ -128,6 +124,7 @@ class OrbExtractor : public PyramidExtractorBase {
 
   std::vector<int> featuresPerLevel_;
   std::array<CircleRowMask, kHalfPatch + 1> circleRows_{};  // orientation circle, per row offset
+  std::vector<cv::Mat> blurred_;  // per level: sizes differ, so one buffer would reallocate
   std::array<LevelScratch, 2> scratch_;
   std::vector<std::vector<Keypoint>> levelKeypoints_;        // per level, before concatenation
   std::vector<std::vector<OrbDescriptor>> levelDescriptors_;
