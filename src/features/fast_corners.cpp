@@ -6,7 +6,7 @@
 #include <bit>
 #include <cstring>
 
-#include "cpu_dispatch.hpp"
+#include "../util/cpu_dispatch.hpp"
 #include "fast_corners_avx2.hpp"
 
 namespace orbis {

@@ -5,7 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "cpu_dispatch.hpp"
+#include "../util/cpu_dispatch.hpp"
 #include "view_context.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))

@@ -18,7 +18,7 @@
 #define ORBIS_AVX2_DISPATCH 1
 #endif
 
-#include "cpu_dispatch.hpp"
+#include "../util/cpu_dispatch.hpp"
 #include "orb_pattern.hpp"
 
 namespace orbis {

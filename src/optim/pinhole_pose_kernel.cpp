@@ -3,6 +3,8 @@
 // run by this CPU; otherwise the entry points take nothing.
 #include "orbis/optim/pinhole_pose_kernel.hpp"
 
+#include "../util/cpu_dispatch.hpp"
+
 namespace orbis::optim::detail {
 
 // The units' entry points (pinhole_pose_kernel_avx2.cpp, pinhole_pose_kernel_avx512.cpp).
@@ -13,19 +15,18 @@ std::size_t costPinholeBlocksAvx512(const PinholePose&, const PinholeResiduals&,
 
 namespace {
 
-bool cpuSupports4() {
-#if defined(ORBIS_HAVE_AVX2_KERNELS) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
+// Whether the four- and eight-lane units are built and this CPU runs them.
+bool fourLanes() {
+#if defined(ORBIS_HAVE_AVX2_KERNELS)
+  return ::orbis::detail::cpuHasAvx2();
 #else
   return false;
 #endif
 }
 
-bool cpuSupports8() {
-#if defined(ORBIS_HAVE_AVX512_KERNELS) && defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool has = __builtin_cpu_supports("avx512f");
-  return has;
+bool eightLanes() {
+#if defined(ORBIS_HAVE_AVX512_KERNELS)
+  return ::orbis::detail::cpuHasAvx512f();
 #else
   return false;
 #endif
@@ -33,7 +34,7 @@ bool cpuSupports8() {
 
 // The lanes a call runs with: `lanes` if available, the widest available for 0, else none.
 int resolveLanes(int lanes) {
-  if (lanes == 0) return cpuSupports8() ? 8 : cpuSupports4() ? 4 : 0;
+  if (lanes == 0) return eightLanes() ? 8 : fourLanes() ? 4 : 0;
   return pinholePoseKernelAvailable(lanes) ? lanes : 0;
 }
 
@@ -41,9 +42,9 @@ int resolveLanes(int lanes) {
 
 bool pinholePoseKernelAvailable(int lanes) {
   switch (lanes) {
-    case 0: return cpuSupports8() || cpuSupports4();
-    case 4: return cpuSupports4();
-    case 8: return cpuSupports8();
+    case 0: return eightLanes() || fourLanes();
+    case 4: return fourLanes();
+    case 8: return eightLanes();
     default: return false;
   }
 }

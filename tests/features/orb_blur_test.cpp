@@ -1,8 +1,11 @@
-// orbBlur's integer path (AVX2, views with 3 pixels of context) against the sepFilter2D it
-// replaces and against the exact sum rounded half to even, bit for bit: widths narrower and
-// wider than a vector, textured, noisy and extreme images (rounding ties included). The second
-// reference keeps the test meaningful where orbBlur itself falls back to sepFilter2D.
+// orbBlur's integer paths (AVX2 and AVX-512 where the CPU has them, each forced in turn; views
+// with 3 pixels of context) against the sepFilter2D they replace and against the exact sum
+// rounded half to even, bit for bit: widths narrower and wider than a vector, textured, noisy and
+// extreme images (rounding ties included). The second reference keeps the test meaningful where
+// orbBlur itself falls back to sepFilter2D.
 #include <gtest/gtest.h>
+
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -46,14 +49,20 @@ TEST(OrbBlur, ViewsWithContextGiveSepFilter2DsBits) {
     for (int x = 0; x < extremes.cols; ++x)
       extremes.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(((x / 3 + y / 2) % 2) ? 255 : rng.uniform(0, 3));
   const cv::Mat parents[] = {test::texturedImage(700, 90, 4, 150), noise, extremes};
+  std::vector<BlurCode> codes;
+  for (const BlurCode code : {BlurCode::Best, BlurCode::Portable, BlurCode::Avx2, BlurCode::Avx512})
+    if (blurCodeAvailable(code)) codes.push_back(code);
   for (const cv::Mat& parent : parents)
     for (const int width : {16, 17, 31, 32, 33, 100, 641})
       for (const int margin : {3, 19}) {
         const cv::Mat view = parent(cv::Rect(margin, margin, width, parent.rows - 2 * margin));
-        cv::Mat ours(view.size(), CV_8UC1, cv::Scalar(7));
-        orbBlur(view, ours);
         const cv::Mat exact = integerBlur(view);
-        EXPECT_EQ(cv::norm(ours, exact, cv::NORM_INF), 0.0) << "width " << width << ", margin " << margin;
+        for (const BlurCode code : codes) {
+          cv::Mat ours(view.size(), CV_8UC1, cv::Scalar(7));
+          orbBlur(view, ours, code);
+          EXPECT_EQ(cv::norm(ours, exact, cv::NORM_INF), 0.0)
+              << "code " << static_cast<int>(code) << ", width " << width << ", margin " << margin;
+        }
         EXPECT_EQ(cv::norm(sepFilterBlur(view), exact, cv::NORM_INF), 0.0) << "width " << width << ", margin " << margin;
       }
 }

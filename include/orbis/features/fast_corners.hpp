@@ -12,7 +12,8 @@
 // image cropped to that sub-area plus 3 pixels — keeping those left of `keepBelowX` (map
 // columns). The code is picked once at run time: AVX-512BW scores (with AVX2 suppression) or AVX2
 // where the CPU has them, else portable one-pixel-at-a-time code (correct, but slower than
-// cv::FAST: OrbExtractor uses cv::FAST there). Every path gives the same output. Thread-safe; the buffers are the caller's.
+// cv::FAST: OrbExtractor uses cv::FAST there). Every path gives the same output. Thread-safe;
+// the buffers are the caller's.
 // Design and measurements: docs/notes/2026-11-27-own-fast.md.
 #pragma once
 

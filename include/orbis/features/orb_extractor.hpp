@@ -135,9 +135,18 @@ class OrbExtractor : public PyramidExtractorBase {
 
 static_assert(FeatureExtractor<OrbExtractor>);
 
+// Which code computes orbBlur: the best this CPU runs, or one forced (tests). Every code gives
+// the same bits; the vector codes need a view with 3 pixels of context and at least 16 (AVX2) or
+// 32 (AVX-512BW) columns, and leave other images to the portable code (OpenCV's sepFilter2D).
+enum class BlurCode { Best, Portable, Avx2, Avx512 };
+
+// Whether this build and CPU can run `code`; Best and Portable always can.
+bool blurCodeAvailable(BlurCode code);
+
 // The extractor's pre-descriptor blur: `dst` = `src` filtered by OrbExtractor::kBlurTapsQ8 in
 // both directions, reflecting (101) at the borders of src's parent image. Equal to
-// cv::GaussianBlur(7x7, sigma 2) of a whole image up to rounding ties (off by one).
-void orbBlur(const cv::Mat& src, cv::Mat& dst);
+// cv::GaussianBlur(7x7, sigma 2) of a whole image up to rounding ties (off by one). `code` must
+// be available.
+void orbBlur(const cv::Mat& src, cv::Mat& dst, BlurCode code = BlurCode::Best);
 
 }  // namespace orbis
