@@ -27,6 +27,14 @@ class FeatureGrid {
   static constexpr int kRows = 48;
   // @}
 
+  // Allocates and writes the storage for `keypoints` keypoints, so that a later build() of as
+  // many reuses it (features/feature_storage.hpp prepares frames' storage this way).
+  void reserve(std::size_t keypoints) {
+    cellStart_.assign(kCols * kRows + 1, 0);
+    entries_.resize(keypoints);
+    entries_.clear();
+  }
+
   // Bins keypoints over the undistorted image bounds [minX, maxX) × [minY, maxY).
   void build(std::span<const Keypoint> keypoints, float minX, float maxX, float minY, float maxY) {
     minX_ = minX;
