@@ -3,7 +3,7 @@
 //
 // Why: a frame that becomes a keyframe keeps its features for the map's lifetime, so every
 // keyframe takes new memory, and a page touched for the first time costs a page fault (about
-// 11 µs each on the 2-core VM the benchmarks run on, ~25 per monocular keyframe). Built in the
+// 11 µs each on the 2-core VM the benchmarks run on; 100 KB is about 25 pages). Built in the
 // tracking thread, those faults land inside the frame's call; copied into storage prepared
 // beforehand by another thread, they land outside it, and the tracking thread's own buffers are
 // freed and reused by the next frame. docs/notes/2026-11-29-speed-page-faults.md.

@@ -22,7 +22,6 @@
 #include "orbis/camera/pinhole.hpp"
 #include "orbis/camera/sensor_kind.hpp"
 #include "orbis/camera/stereo.hpp"
-#include "orbis/features/feature_storage.hpp"
 #include "orbis/features/frame_features.hpp"
 #include "orbis/features/orb_extractor.hpp"
 #include "orbis/features/stereo_matcher.hpp"
@@ -96,9 +95,7 @@ struct Stereo {
       matcher_.setParallel(true);  // after the two extractions, which ran one per core
     }
     // The frame's features.
-    FrameFeatures build(const Input& in) {
-      return storage_.keep(extractStereo(left_, right_, in.left, in.right, camera_, matcher_));
-    }
+    FrameFeatures build(const Input& in) { return extractStereo(left_, right_, in.left, in.right, camera_, matcher_); }
 
    private:
     static OrbParams rightParams(OrbParams orb) {
@@ -108,7 +105,6 @@ struct Stereo {
     Camera camera_;
     OrbExtractor left_, right_;
     StereoMatcher matcher_;
-    FeatureStorageReserve storage_;  // what a keyframe keeps, faulted in off the frame's call
   };
 };
 
@@ -137,13 +133,12 @@ struct Rgbd {
     }
     // The frame's features.
     FrameFeatures build(const Input& in) {
-      return storage_.keep(extractRgbd(extractor_, in.image, in.depth, in.depth.depth() == CV_32F ? metric_ : camera_));
+      return extractRgbd(extractor_, in.image, in.depth, in.depth.depth() == CV_32F ? metric_ : camera_);
     }
 
    private:
     Camera camera_, metric_;  // metric_: the same camera reading depth already in metres
     OrbExtractor extractor_;
-    FeatureStorageReserve storage_;  // what a keyframe keeps, faulted in off the frame's call
   };
 };
 
@@ -166,7 +161,7 @@ class MonocularFeatureBuilder {
   }
   // The frame's features.
   FrameFeatures build(const MonocularInput& in) {
-    return storage_.keep(keypointsOf_(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image));
+    return keypointsOf_(isInitialising_ ? initialisationExtractor_ : trackingExtractor_, in.image);
   }
   // Switches the initialisation budget on or off (the tracker's owner does).
   void setInitialising(bool initialising) { isInitialising_ = initialising; }
@@ -180,7 +175,6 @@ class MonocularFeatureBuilder {
   }
   KeypointsOf keypointsOf_;
   OrbExtractor trackingExtractor_, initialisationExtractor_;
-  FeatureStorageReserve storage_;  // what a keyframe keeps, faulted in off the frame's call
   bool isInitialising_ = true;
 };
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include "orbis/features/feature_storage.hpp"
 #include "orbis/sensor/sensor.hpp"
 #include "orbis/system/slam_core.hpp"
 #include "orbis/util/timing.hpp"
@@ -52,7 +53,7 @@ class Slam {
       using Clock = std::chrono::steady_clock;
       const Clock::time_point start = core_.observesFrames() ? Clock::now() : Clock::time_point{};
       ScopedStage stage(&core_.timer(), "tracking: ORB extraction");
-      features = std::make_shared<const FrameFeatures>(builder_.build(input));
+      features = std::make_shared<const FrameFeatures>(storage_.keep(builder_.build(input)));
       if (core_.observesFrames()) extractionMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     }
     const TrackResult result = core_.track(std::move(features), input.timestamp, extractionMs, observedImage(input));
@@ -98,6 +99,9 @@ class Slam {
   }
 
   typename Sensor::FeatureBuilder builder_;
+  // What a keyframe keeps of the features, in memory faulted in off the frame's call, for every
+  // sensor's builder alike (features/feature_storage.hpp).
+  FeatureStorageReserve storage_;
   SlamCore<Sensor> core_;
 };
 
