@@ -2,6 +2,8 @@
 // keypoints, so only the queue, the waits and the bag-of-words hand-over are exercised:
 //  - a live camera's tracking waits only until the last keyframe's new points exist
 //    (waitUntilTriangulatedFor), not until fusion, local BA and the keyframe sink are done;
+//  - stereo/RGB-D tracking fed faster than a camera waits until the queue has room
+//    (waitUntilQueuedBelowFor), and the wait ends as soon as mapping takes a keyframe;
 //  - a keyframe whose bag of words tracking left for later gets it on the mapping thread.
 #include <gtest/gtest.h>
 
@@ -90,6 +92,36 @@ TEST(LocalMapper, LiveWaitEndsWhenTheKeyFrameIsTriangulatedNotWhenMappingIsIdle)
   EXPECT_TRUE(mapper.waitUntilTriangulatedFor(10s));
   EXPECT_TRUE(mapper.waitUntilIdleFor(10s));
   EXPECT_EQ(gate.entered.load(), 2);
+  mapper.shutdown();
+}
+
+TEST(LocalMapper, QueueWaitEndsWhenMappingTakesAKeyFrame) {
+  const PinholeCamera<double> camera = smallCamera();
+  Map map;
+  LocalMapper<Monocular> mapper(camera, map, LocalMapperOptions{});  // the queue is the same for every sensor
+  SinkGate gate;
+  mapper.setKeyFrameSink([&](KeyFrame*) { gate.pass(); });
+
+  // One keyframe held in the sink, three queued behind it: no room.
+  mapper.insertKeyFrame(emptyKeyFrame(map, 0));
+  gate.waitUntilEntered(1);
+  ASSERT_EQ(gate.entered.load(), 1);
+  EXPECT_TRUE(mapper.waitUntilQueuedBelowFor(1, 0ms)) << "the held keyframe is no longer queued";
+  for (std::uint64_t frame = 1; frame <= 3; ++frame) mapper.insertKeyFrame(emptyKeyFrame(map, frame));
+  ASSERT_EQ(mapper.queuedKeyFrames(), 3u);
+  EXPECT_TRUE(mapper.waitUntilQueuedBelowFor(4, 0ms));
+  EXPECT_FALSE(mapper.waitUntilQueuedBelowFor(3, 50ms));
+
+  // Released, mapping takes the next keyframe off the queue; the wait ends with room for one.
+  std::thread releaser([&] {
+    std::this_thread::sleep_for(20ms);
+    gate.release();
+  });
+  EXPECT_TRUE(mapper.waitUntilQueuedBelowFor(3, 10s));
+  EXPECT_LT(mapper.queuedKeyFrames(), 3u);
+  releaser.join();
+  EXPECT_TRUE(mapper.waitUntilIdleFor(10s));
+  EXPECT_EQ(gate.entered.load(), 4);
   mapper.shutdown();
 }
 

@@ -12,6 +12,10 @@
 
 namespace orbis {
 
+// Stereo/RGB-D tracking makes a keyframe while mapping is busy only while fewer than this many
+// wait (ORB-SLAM2's rule).
+inline constexpr std::size_t kMaxQueuedKeyFrames = 3;
+
 // What tracking and loop closing may ask of local mapping, so neither includes mapping/ (the layer
 // rule).
 class LocalMappingControl {

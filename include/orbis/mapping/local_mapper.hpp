@@ -81,6 +81,9 @@ class LocalMapper final : public LocalMappingControl {
   // Threaded mode: block for at most `budget` until every keyframe queued so far has its new map
   // points (triangulation done; fusion and local BA may still run); true when they have.
   bool waitUntilTriangulatedFor(std::chrono::steady_clock::duration budget);
+  // Threaded mode: block for at most `budget` until fewer than `count` keyframes are queued; true
+  // when they are.
+  bool waitUntilQueuedBelowFor(std::size_t count, std::chrono::steady_clock::duration budget);
   // Finishes queued work and joins the thread.
   void shutdown();
 
@@ -111,7 +114,8 @@ class LocalMapper final : public LocalMappingControl {
   std::function<void(KeyFrame*)> sink_, culledSink_;
 
   std::list<MapPoint*> recentPoints_;
-  // Keyframes queued and keyframes whose new points are made (waitUntilTriangulatedFor).
+  // Keyframes queued and keyframes whose new points are made (waitUntilTriangulatedFor); the
+  // condition is also signalled when a keyframe leaves the queue (waitUntilQueuedBelowFor).
   std::mutex triangulatedMutex_;
   std::condition_variable triangulatedCv_;
   std::uint64_t queuedTotal_ = 0, triangulatedTotal_ = 0;

@@ -169,6 +169,9 @@ class SlamCore {
   // Live monocular: before tracking a frame, wait (at most a frame period) until the keyframe the
   // frame before made has its new points.
   void waitForTriangulationOfLastKeyFrame();
+  // Threaded stereo/RGB-D fed faster than a camera: before tracking a frame, wait until local
+  // mapping's queue is below the keyframe rule's limit.
+  void waitForRoomInMappingQueue();
   // Threaded monocular with a live camera: that wait is bounded by the frame period, which
   // track() then times from its start.
   bool waitBoundedByFramePeriod() const {

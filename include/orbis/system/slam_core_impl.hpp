@@ -96,6 +96,7 @@ TrackResult SlamCore<Sensor>::track(std::shared_ptr<const FrameFeatures> feature
   frame.features = std::move(features);
   TrackResult result;
   if constexpr (!Sensor::kMetricScale) waitForTriangulationOfLastKeyFrame();
+  else waitForRoomInMappingQueue();
   {
     ScopedStage stage(&timer_, "tracking: total");
     result = tracker_->track(std::move(frame));
@@ -212,6 +213,20 @@ void SlamCore<Sensor>::waitForTriangulationOfLastKeyFrame() {
   ScopedStage stage(&timer_, "tracking: wait for mapping");
   const auto period = std::chrono::duration<double>(1.0 / std::max(1.0, options_.fps));
   mapper_->waitUntilTriangulatedFor(std::chrono::duration_cast<std::chrono::steady_clock::duration>(period));
+}
+
+// Stereo/RGB-D, threaded, fed faster than a camera: the keyframe rule (ORB-SLAM2's) refuses a
+// keyframe while mapping has three queued, which with a live camera means mapping cannot keep up
+// and a keyframe must be skipped. Fed flat out, tracking only outran mapping: on the rendered room
+// it refused the keyframes while matches fell 126 -> 21 and was lost (docs/notes/
+// 2026-11-29-speed-page-faults.md). So a frame waits here, outside the map's lock, until the queue
+// has room; bounded so that mapping paused by loop closing cannot hold tracking for long.
+template <SensorConfiguration Sensor>
+void SlamCore<Sensor>::waitForRoomInMappingQueue() {
+  if (options_.deterministic || options_.liveCamera || !mapper_) return;
+  if (mapper_->queuedKeyFrames() < kMaxQueuedKeyFrames) return;
+  ScopedStage stage(&timer_, "tracking: wait for mapping");
+  mapper_->waitUntilQueuedBelowFor(kMaxQueuedKeyFrames, std::chrono::seconds(2));
 }
 
 template <SensorConfiguration Sensor>

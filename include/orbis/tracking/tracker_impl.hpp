@@ -562,7 +562,7 @@ bool Tracker<Sensor>::needNewKeyFrame() const {
   if (mapperIdle) return true;
   if (mapper_) mapper_->interruptBundleAdjustment();
   if constexpr (!Sensor::kMetricScale) return false;
-  return mapper_ && mapper_->queuedKeyFrames() < 3;
+  return mapper_ && mapper_->queuedKeyFrames() < kMaxQueuedKeyFrames;
 }
 
 template <SensorConfiguration Sensor>
