@@ -1,8 +1,9 @@
-// FeatureStorageReserve: what keep() returns equals what was built, in the storage prepared
-// after the previous keep() whenever it is large enough.
+// FeatureStorageReserve: what keep() returns equals what was built, in storage prepared
+// beforehand (a batch at a time) for every frame after the first.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <vector>
 
 #include "features/feature_test_util.hpp"
 #include "orbis/features/feature_storage.hpp"
@@ -56,6 +57,21 @@ TEST(FeatureStorageReserve, KeepsEqualFeaturesInThePreparedStorage) {
   EXPECT_GT(keptSecond.descriptors.capacity(), first.size());
   EXPECT_GT(keptSecond.keypointsUn.capacity(), first.size());
   EXPECT_GT(keptSecond.depth.capacity(), first.size());
+}
+
+TEST(FeatureStorageReserve, EveryFrameAfterTheFirstGoesIntoPreparedStorage) {
+  FeatureStorageReserve reserve;
+  const FrameFeatures f = featuresOf(5, 1000);
+  const std::size_t preparedSize = f.size() + f.size() / 8 + 64;
+  std::vector<FrameFeatures> kept;  // held, as keyframes hold theirs
+  for (std::size_t i = 0; i < 3 * FeatureStorageReserve::kBatch + 1; ++i) kept.push_back(reserve.keep(f));
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    expectSame(kept[i], f);
+    if (i == 0) continue;  // nothing prepared before the first
+    // A plain copy would have a capacity of f.size().
+    EXPECT_GE(kept[i].keypoints.capacity(), preparedSize) << "frame " << i;
+    EXPECT_GE(kept[i].descriptors.capacity(), preparedSize) << "frame " << i;
+  }
 }
 
 TEST(FeatureStorageReserve, AFrameLargerThanPreparedIsStillCopiedWhole) {

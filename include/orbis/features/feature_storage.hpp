@@ -9,13 +9,16 @@
 // freed and reused by the next frame. docs/notes/2026-11-29-speed-page-faults.md.
 //
 // Contract: keep(built) returns a FrameFeatures equal to `built` (every array and the grid
-// copied), in the storage prepared after the previous keep() when it is large enough (else the
-// copy allocates as usual). Then it starts preparing the next storage on its thread, sized for
-// `built` with some margin. One owner calls keep() (not thread-safe). The values never depend
+// copied), in storage prepared beforehand when there is some (else the copy allocates as usual;
+// a prepared array too small grows as usual). Storage is prepared kBatch at a time on the helper
+// thread, sized for the frame that used up the last batch with some margin, so the helper is
+// woken once every kBatch frames: waking it costs the caller about 50 us on the 2-core VM, more
+// than the copy (same note). One owner calls keep() (not thread-safe). The values never depend
 // on the preparation: deterministic runs stay deterministic.
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "orbis/features/frame_features.hpp"
 #include "orbis/util/helper_thread.hpp"
@@ -28,15 +31,32 @@ class FeatureStorageReserve {
   FeatureStorageReserve() = default;
   FeatureStorageReserve(const FeatureStorageReserve&) = delete;
   FeatureStorageReserve& operator=(const FeatureStorageReserve&) = delete;
-  ~FeatureStorageReserve() { helper_.join(); }  // the job writes spare_, which goes after this
+  ~FeatureStorageReserve() { helper_.join(); }  // the job writes incoming_, which goes after this
 
-  // `built`, copied into the prepared storage; starts preparing the next.
+  // Prepared storages per wake of the helper.
+  static constexpr std::size_t kBatch = 4;
+
+  // `built`, copied into prepared storage; starts preparing the next batch when none is left.
   FrameFeatures keep(const FrameFeatures& built) {
-    helper_.join();  // prepared during the last frame period: normally long done
-    FrameFeatures kept = std::move(spare_);
+    if (spares_.empty() && preparing_) {
+      helper_.join();  // started kBatch - 1 frames ago: normally long done
+      preparing_ = false;
+      spares_.swap(incoming_);
+    }
+    FrameFeatures kept;
+    if (!spares_.empty()) {
+      kept = std::move(spares_.back());
+      spares_.pop_back();
+    }
     kept = built;  // copy assignment reuses each array's capacity
-    const std::size_t n = built.size() + built.size() / 8 + 64;
-    helper_.run([this, n] { spare_ = prepared(n); });
+    if (spares_.empty()) {
+      const std::size_t n = built.size() + built.size() / 8 + 64;
+      preparing_ = true;
+      helper_.run([this, n] {
+        incoming_.clear();
+        for (std::size_t i = 0; i < kBatch; ++i) incoming_.push_back(prepared(n));
+      });
+    }
     return kept;
   }
 
@@ -59,7 +79,9 @@ class FeatureStorageReserve {
     v.clear();    // keeps the capacity
   }
 
-  FrameFeatures spare_;
+  std::vector<FrameFeatures> spares_;    // prepared, ready for keep()
+  std::vector<FrameFeatures> incoming_;  // written by the helper's job while preparing_
+  bool preparing_ = false;
   HelperThread helper_;
 };
 
