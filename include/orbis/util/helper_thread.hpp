@@ -10,9 +10,12 @@
 // it on every path out of a scope). The thread starts on the first run() and is joined by the
 // destructor. The job must not throw. Everything the job did happens-before join()'s return.
 // run() wakes the thread on a core other than the caller's (WakeSteering), so that after a
-// camera's frame period of idling the job does not wait for the caller's core.
+// camera's frame period of idling the job does not wait for the caller's core; the thread undoes
+// that steering after the job, so between jobs it has every core it had. join() spins briefly
+// before it blocks.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -40,20 +43,29 @@ class HelperThread {
 
   // Starts `job` on the helper thread.
   void run(std::function<void()> job) {
+    // Steered before the job is visible: a thread that is still awake from the last job may take
+    // it at once, and the steering must be there for the settle that follows the job.
+    const bool started = thread_.joinable();
+    if (started) steering_.steerAwayFromCaller();
     {
       std::lock_guard lock(mutex_);
       job_ = std::move(job);
       pending_ = true;
     }
-    if (!thread_.joinable()) thread_ = std::thread([this] { serve(); });
-    else steering_.steerAwayFromCaller();
+    if (!started) thread_ = std::thread([this] { serve(); });
     wake_.notify_one();
   }
 
-  // Waits until the job run() started has returned.
+  // Waits until the job run() started has returned: spinning a little first, for a job that is
+  // about to end, since a thread blocked here is woken tens of microseconds after the notify on
+  // the 2-core VM (docs/notes/2026-11-29-speed-tracking-on-two-cores.md).
   void join() {
+    for (int i = 0; i < kJoinSpins; ++i) {
+      if (!pending_.load(std::memory_order_acquire)) return;
+      pause();
+    }
     std::unique_lock lock(mutex_);
-    done_.wait(lock, [this] { return !pending_; });
+    done_.wait(lock, [this] { return !pending_.load(std::memory_order_acquire); });
   }
 
   // Joins the helper when the scope ends, also when the owner's share of the work throws.
@@ -74,23 +86,39 @@ class HelperThread {
     steering_.adoptThisThread();
     std::unique_lock lock(mutex_);
     for (;;) {
-      wake_.wait(lock, [this] { return stop_ || (pending_ && job_); });
-      if (stop_ && !pending_) return;
+      wake_.wait(lock, [this] { return stop_ || (pending_.load() && job_); });
+      if (stop_ && !pending_.load()) return;
       std::function<void()> job = std::move(job_);
       job_ = nullptr;
       lock.unlock();
-      steering_.settle();
       job();
       lock.lock();
-      pending_ = false;
+      pending_.store(false, std::memory_order_release);
       done_.notify_one();
+      // Undone after the job, not before it: the system call delayed the job's start
+      // (docs/notes/2026-11-29-speed-tracking-on-two-cores.md).
+      lock.unlock();
+      steering_.settle();
+      lock.lock();
     }
+  }
+
+  static constexpr int kJoinSpins = 2000;  // about 20-50 us
+
+  static void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    asm volatile("yield");
+#endif
   }
 
   std::mutex mutex_;
   std::condition_variable wake_, done_;
   std::function<void()> job_;
-  bool pending_ = false;  // a job was handed over and has not returned yet
+  // A job was handed over and has not returned yet; written under mutex_, read without it by
+  // join()'s spin.
+  std::atomic<bool> pending_{false};
   bool stop_ = false;
   WakeSteering steering_;
   std::thread thread_;

@@ -13,7 +13,8 @@
 //   machines an idle virtual CPU does not count as free), and the helper then waits there until
 //   the waker blocks or the load balancer moves it: about 1 ms after a 33 ms camera period on the
 //   2-core VM of docs/notes/2026-11-27-speed-scheduling.md, a third of a frame's extraction. The
-//   helper calls adoptThisThread() once when it starts and settle() each time it wakes; the waker
+//   helper calls adoptThisThread() once when it starts and settle() after each job it was woken
+//   for (HelperThread: after, so that the system call does not delay the job); the waker
 //   calls steerAwayFromCaller() before waking it. The steering lasts until settle(), which gives
 //   the helper back every core it was allowed at adoptThisThread(), so a user's taskset or cpuset
 //   is kept. With one allowed core it does nothing.
@@ -45,7 +46,7 @@ class WakeSteering {
   void adoptThisThread();
   // On the waking thread, before it wakes the helper; true when the helper was steered.
   bool steerAwayFromCaller();
-  // On the helper thread, each time it wakes: undoes the steering, if any.
+  // On the helper thread, after the job it was woken for: undoes the steering, if any.
   void settle();
 
  private:
