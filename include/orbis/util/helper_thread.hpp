@@ -92,6 +92,7 @@ class HelperThread {
       job_ = nullptr;
       lock.unlock();
       job();
+      job = nullptr;  // before join() can return: what the job holds goes while the owner waits
       lock.lock();
       pending_.store(false, std::memory_order_release);
       done_.notify_one();
