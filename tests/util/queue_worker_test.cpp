@@ -1,9 +1,11 @@
 // QueueWorker::waitUntilIdleFor (util/queue_worker.hpp): gives up after its budget while the
-// worker is serving, and returns true once the queue is empty and the worker idle.
+// worker is serving, and returns true once the queue is empty and the worker idle;
+// waitUntilFewerThanFor: gives up while the queue is that long, and returns once an item is taken.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
+#include <thread>
 
 #include "orbis/util/queue_worker.hpp"
 
@@ -30,6 +32,20 @@ TEST(QueueWorker, WaitUntilIdleForGivesUpWhileServingAndSucceedsOnceIdle) {
   EXPECT_TRUE(worker.waitUntilIdleFor(60s));  // returns as soon as the item is done
   EXPECT_EQ(served.load(), 1);
   worker.stop();
+}
+
+TEST(QueueWorker, WaitUntilFewerThanForEndsWhenAnItemIsTaken) {
+  QueueWorker<int> worker;  // not started: the test takes the items
+  for (int i = 0; i < 3; ++i) worker.push(i);
+  EXPECT_TRUE(worker.waitUntilFewerThanFor(4, 0ms));
+  EXPECT_FALSE(worker.waitUntilFewerThanFor(3, 20ms));
+  std::thread taker([&] {
+    std::this_thread::sleep_for(20ms);
+    worker.pop();
+  });
+  EXPECT_TRUE(worker.waitUntilFewerThanFor(3, 60s));
+  EXPECT_EQ(worker.size(), 2u);
+  taker.join();
 }
 
 }  // namespace

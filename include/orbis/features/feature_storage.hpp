@@ -38,10 +38,9 @@ class FeatureStorageReserve {
 
   // `built`, copied into prepared storage; starts preparing the next batch when none is left.
   FrameFeatures keep(const FrameFeatures& built) {
-    if (spares_.empty() && preparing_) {
-      helper_.join();  // started kBatch - 1 frames ago: normally long done
-      preparing_ = false;
-      spares_.swap(incoming_);
+    if (spares_.empty()) {
+      helper_.join();  // the batch started kBatch - 1 frames ago: normally long done
+      spares_.swap(incoming_);  // empty before the first batch
     }
     FrameFeatures kept;
     if (!spares_.empty()) {
@@ -51,9 +50,7 @@ class FeatureStorageReserve {
     kept = built;  // copy assignment reuses each array's capacity
     if (spares_.empty()) {
       const std::size_t n = built.size() + built.size() / 8 + 64;
-      preparing_ = true;
-      helper_.run([this, n] {
-        incoming_.clear();
+      helper_.run([this, n] {  // incoming_ is empty: it was swapped with the used-up spares_
         for (std::size_t i = 0; i < kBatch; ++i) incoming_.push_back(prepared(n));
       });
     }
@@ -80,8 +77,7 @@ class FeatureStorageReserve {
   }
 
   std::vector<FrameFeatures> spares_;    // prepared, ready for keep()
-  std::vector<FrameFeatures> incoming_;  // written by the helper's job while preparing_
-  bool preparing_ = false;
+  std::vector<FrameFeatures> incoming_;  // written by the helper's job between run() and join()
   HelperThread helper_;
 };
 

@@ -114,8 +114,7 @@ class LocalMapper final : public LocalMappingControl {
   std::function<void(KeyFrame*)> sink_, culledSink_;
 
   std::list<MapPoint*> recentPoints_;
-  // Keyframes queued and keyframes whose new points are made (waitUntilTriangulatedFor); the
-  // condition is also signalled when a keyframe leaves the queue (waitUntilQueuedBelowFor).
+  // Keyframes queued and keyframes whose new points are made (waitUntilTriangulatedFor).
   std::mutex triangulatedMutex_;
   std::condition_variable triangulatedCv_;
   std::uint64_t queuedTotal_ = 0, triangulatedTotal_ = 0;

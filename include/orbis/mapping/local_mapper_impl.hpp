@@ -131,18 +131,13 @@ bool LocalMapper<Sensor>::waitUntilTriangulatedFor(std::chrono::steady_clock::du
 
 template <SensorConfiguration Sensor>
 bool LocalMapper<Sensor>::waitUntilQueuedBelowFor(std::size_t count, std::chrono::steady_clock::duration budget) {
-  std::unique_lock lock(triangulatedMutex_);
-  return triangulatedCv_.wait_for(lock, budget, [&] { return queuedKeyFrames() < count; });
+  return worker_.waitUntilFewerThanFor(count, budget);
 }
 
 template <SensorConfiguration Sensor>
 bool LocalMapper<Sensor>::processOne() {
   const std::optional<KeyFrame*> next = worker_.pop();
   if (!next) return false;
-  {
-    std::lock_guard lock(triangulatedMutex_);  // a waiter's predicate reads the queue under it
-  }
-  triangulatedCv_.notify_all();
   KeyFrame* kf = *next;
   ScopedStage total(timer_, "mapping: total");
   diagnostics_.clear();

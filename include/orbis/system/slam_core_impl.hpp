@@ -219,11 +219,11 @@ void SlamCore<Sensor>::waitForTriangulationOfLastKeyFrame() {
 // keyframe while mapping has three queued, which with a live camera means mapping cannot keep up
 // and a keyframe must be skipped. Fed flat out, tracking only outran mapping: on the rendered room
 // it refused the keyframes while matches fell 126 -> 21 and was lost (docs/notes/
-// 2026-11-29-speed-page-faults.md). So a frame waits here, outside the map's lock, until the queue
+// 2026-11-29-mapping-queue-wait.md). So a frame waits here, outside the map's lock, until the queue
 // has room; bounded so that mapping paused by loop closing cannot hold tracking for long.
 template <SensorConfiguration Sensor>
 void SlamCore<Sensor>::waitForRoomInMappingQueue() {
-  if (options_.deterministic || options_.liveCamera || !mapper_) return;
+  if (options_.deterministic || options_.liveCamera) return;  // inline mapping; a camera's pace
   if (mapper_->queuedKeyFrames() < kMaxQueuedKeyFrames) return;
   ScopedStage stage(&timer_, "tracking: wait for mapping");
   mapper_->waitUntilQueuedBelowFor(kMaxQueuedKeyFrames, std::chrono::seconds(2));

@@ -6,7 +6,8 @@
 // (pop()) and returns when it wants to wait again. Without start() nothing runs on its own: the
 // owner drains the queue on its thread (deterministic mode). waitUntilIdle(drainInline) blocks
 // until the queue is empty and the worker idle, or, with no worker, drains it inline;
-// waitUntilIdleFor(budget) waits the same way for at most budget (threaded). stop() wakes and
+// waitUntilIdleFor(budget) waits the same way for at most budget (threaded);
+// waitUntilFewerThanFor(count, budget) until fewer than count items are queued. stop() wakes and
 // joins the worker; items still queued stay queued.
 #pragma once
 
@@ -69,10 +70,14 @@ class QueueWorker {
   }
   // Takes the oldest item, if any.
   std::optional<Item> pop() {
-    std::lock_guard lock(mutex_);
-    if (queue_.empty()) return std::nullopt;
-    Item item = std::move(queue_.front());
-    queue_.pop_front();
+    std::optional<Item> item;
+    {
+      std::lock_guard lock(mutex_);
+      if (queue_.empty()) return std::nullopt;
+      item = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    queueCv_.notify_all();  // waitUntilFewerThanFor
     return item;
   }
   // Items queued.
@@ -106,6 +111,12 @@ class QueueWorker {
     return waitIdleUntil(std::chrono::steady_clock::now() + budget, {});
   }
 
+  // Blocks for at most `budget` until fewer than `count` items are queued; true when they are.
+  bool waitUntilFewerThanFor(std::size_t count, std::chrono::steady_clock::duration budget) {
+    std::unique_lock lock(mutex_);
+    return queueCv_.wait_for(lock, budget, [&] { return queue_.size() < count; });
+  }
+
   // Asks the thread to finish and joins it.
   void stop() {
     finish_ = true;
@@ -134,7 +145,8 @@ class QueueWorker {
 
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::condition_variable idleCv_;  // the worker finished serving
+  std::condition_variable idleCv_;   // the worker finished serving
+  std::condition_variable queueCv_;  // an item was taken off the queue
   std::deque<Item> queue_;
   std::atomic<bool> busy_{false};
   std::atomic<bool> finish_{false};
