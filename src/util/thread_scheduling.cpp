@@ -6,8 +6,11 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #endif
 
 namespace orbis {
@@ -84,6 +87,14 @@ void WakeSteering::settle() {}
 #endif
 
 bool isThisThreadBackground() { return background; }
+
+void nameThisThread([[maybe_unused]] const char* name) {
+#if defined(__linux__)
+  char truncated[16] = {};
+  std::strncpy(truncated, name, sizeof(truncated) - 1);
+  ::pthread_setname_np(::pthread_self(), truncated);
+#endif
+}
 
 WakeSteering::WakeSteering() : state_(std::make_unique<State>()) {}
 WakeSteering::~WakeSteering() = default;

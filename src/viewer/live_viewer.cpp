@@ -18,6 +18,7 @@
 #include <unordered_set>
 
 #include "orbis/util/error.hpp"
+#include "orbis/util/thread_scheduling.hpp"
 #include "frame_image.hpp"
 #include "map_delta.hpp"
 #include "scene_json.hpp"
@@ -284,10 +285,12 @@ LiveViewer::LiveViewer(ViewerOptions options) : impl_(std::make_unique<Impl>()) 
   if (!impl_->server.bind_to_port(impl_->options.host.c_str(), impl_->options.port))
     throw Error("viewer", "", "cannot listen on " + url() + " (port in use?)");
   impl_->serverThread = std::thread([this] {
+    nameThisThread("orbis-viewer");
     yieldToSlam();
     impl_->server.listen_after_bind();
   });
   impl_->publisherThread = std::thread([this] {
+    nameThisThread("orbis-publisher");
     yieldToSlam();
     impl_->publishLoop();
   });

@@ -2,10 +2,12 @@
 // WakeSteering keeps a woken helper off its waker's core until it settles, then gives it back
 // every core it had.
 #include <gtest/gtest.h>
+#include <pthread.h>
 
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -83,6 +85,34 @@ TEST(ThreadScheduling, BackgroundCallersGetBackgroundHelpers) {
   });
   ASSERT_EQ(nices.size(), 8u);
   for (int n : nices) EXPECT_EQ(n, base);
+}
+
+// The name a thread gave itself, read back as tools read it.
+std::string nameOfThisThread() {
+  char name[64] = {};
+  EXPECT_EQ(::pthread_getname_np(::pthread_self(), name, sizeof(name)), 0);
+  return name;
+}
+
+TEST(ThreadScheduling, NamesThreadsAsToolsShowThem) {
+  std::string shortName, longName;
+  std::thread([&] {
+    nameThisThread("orbis-mapping");
+    shortName = nameOfThisThread();
+    nameThisThread("orbis-a-name-longer-than-fifteen");
+    longName = nameOfThisThread();
+  }).join();
+  EXPECT_EQ(shortName, "orbis-mapping");
+  EXPECT_EQ(longName, "orbis-a-name-lo");  // Linux keeps 15 characters
+}
+
+// Every thread orbis starts is named, so a profile can be split by thread.
+TEST(ThreadScheduling, HelperThreadIsNamed) {
+  HelperThread helper;
+  std::string name;
+  helper.run([&] { name = nameOfThisThread(); });
+  helper.join();
+  EXPECT_EQ(name, "orbis-helper");
 }
 
 cpu_set_t affinityOf(pid_t tid) {

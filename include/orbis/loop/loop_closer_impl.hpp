@@ -30,7 +30,7 @@ LoopCloser<Sensor>::LoopCloser(const Camera& camera, Map& map, LocalMappingContr
           while (!worker_.finishing() && processOne()) {
           }
         },
-        options_.backgroundPriority);
+        options_.backgroundPriority, "orbis-loop");
 }
 
 template <SensorConfiguration Sensor>

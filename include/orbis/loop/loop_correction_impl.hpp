@@ -238,6 +238,7 @@ void LoopCloser<Sensor>::startFullBundleAdjustment(std::uint32_t mapId) {
     return;
   }
   fullBaThread_ = std::thread([this] {
+    nameThisThread("orbis-full-ba");
     if (options_.backgroundPriority) lowerThisThreadPriority();
     runFullBundleAdjustment();
     fullBaRunning_ = false;

@@ -17,7 +17,7 @@ namespace orbis {
 template <SensorConfiguration Sensor>
 LocalMapper<Sensor>::LocalMapper(const Camera& camera, Map& map, LocalMapperOptions options, StageTimer* timer)
     : camera_(camera), map_(map), options_(options), timer_(timer) {
-  if (options_.threaded) worker_.start([this] { serveQueue(); }, options_.backgroundPriority);
+  if (options_.threaded) worker_.start([this] { serveQueue(); }, options_.backgroundPriority, "orbis-mapping");
 }
 
 template <SensorConfiguration Sensor>

@@ -83,6 +83,7 @@ class HelperThread {
 
  private:
   void serve() {
+    nameThisThread("orbis-helper");
     steering_.adoptThisThread();
     std::unique_lock lock(mutex_);
     for (;;) {

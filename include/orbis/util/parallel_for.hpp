@@ -85,6 +85,7 @@ class HelperPool {
   }
 
   void serve(int index) {
+    nameThisThread("orbis-pool");
     unsigned long seen = 0;
     for (;;) {
       const std::function<void(int)>* job;

@@ -37,8 +37,9 @@ class QueueWorker {
 
   // Starts the thread, which calls serve() whenever items are queued or it is woken; with
   // `background` at a lower priority than the caller's (util/thread_scheduling.hpp).
-  void start(std::function<void()> serve, bool background = false) {
-    thread_ = std::thread([this, background, serve = std::move(serve)] {
+  void start(std::function<void()> serve, bool background = false, const char* name = "orbis-worker") {
+    thread_ = std::thread([this, background, name, serve = std::move(serve)] {
+      nameThisThread(name);
       if (background) lowerThisThreadPriority();
       while (!finishing()) {
         {

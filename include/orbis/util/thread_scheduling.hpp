@@ -8,6 +8,7 @@
 //   inherit the lower priority.
 //   Local mapping, loop closing and full BA call it in threaded mode (SlamOptions::
 //   backgroundPriority); parallelFor gives such a caller helpers at the same priority.
+// - nameThisThread() names the calling thread (orbis' threads are named "orbis-…").
 // - WakeSteering places a woken helper thread on a core other than its waker's. Linux tends to
 //   wake a thread on the waker's core when the other cores have been idle a while (on virtual
 //   machines an idle virtual CPU does not count as free), and the helper then waits there until
@@ -33,6 +34,10 @@ inline constexpr int kBackgroundNice = 10;
 bool lowerThisThreadPriority();
 // Whether lowerThisThreadPriority() took on the calling thread.
 bool isThisThreadBackground();
+
+// Names the calling thread for tools that list threads (top -H, perf report --comm, gdb); Linux
+// keeps the first 15 characters. Does nothing elsewhere.
+void nameThisThread(const char* name);
 
 // Steers a helper thread's wake-ups away from its waker's core (see the contract).
 class WakeSteering {
