@@ -17,7 +17,8 @@ KeyFrame::KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, co
       bow_(std::move(bowVector)),
       featureVector_(std::move(featureVector)),
       Tcw_(Tcw),
-      points_(features_->size(), nullptr) {}
+      points_(features_->size(), nullptr),
+      occupied_((points_.size() + 63) / 64, 0) {}
 
 KeyFrame::KeyFrame(KeyFrameId id, std::uint64_t frameIndex, double timestamp, const SE3d& Tcw,
                    std::shared_ptr<const FrameFeatures> features, const MapIntrinsics& intrinsics,
@@ -35,21 +36,26 @@ void KeyFrame::ensureBow() const {
 }
 
 void KeyFrame::erasePoint(const MapPoint* p) {
-  for (auto& slot : points_)
-    if (slot == p) slot = nullptr;
+  for (std::size_t w = 0; w < occupied_.size(); ++w)
+    for (std::uint64_t bits = occupied_[w]; bits != 0; bits &= bits - 1) {
+      const std::size_t i = w * 64 + static_cast<std::size_t>(std::countr_zero(bits));
+      if (points_[i] == p) erasePoint(i);
+    }
 }
 
 int KeyFrame::trackedPoints(int minObservations) const {
   int n = 0;
-  for (const MapPoint* p : points_)
-    if (p && !p->isBad() && (minObservations <= 0 || p->observationCount() >= minObservations)) ++n;
+  forEachPoint([&](const MapPoint* p) {
+    if (!p->isBad() && (minObservations <= 0 || p->observationCount() >= minObservations)) ++n;
+  });
   return n;
 }
 
 std::vector<MapPoint*> KeyFrame::goodPoints() const {
   std::vector<MapPoint*> out;
-  for (MapPoint* p : points_)
-    if (p && !p->isBad()) out.push_back(p);
+  forEachPoint([&](MapPoint* p) {
+    if (!p->isBad()) out.push_back(p);
+  });
   std::sort(out.begin(), out.end(), ById{});
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -154,7 +160,7 @@ bool KeyFrame::setBad() {
   for (const auto& [kf, w] : connectedWeights_) kf->eraseConnection(this);
   for (std::size_t i = 0; i < points_.size(); ++i)
     if (MapPoint* p = points_[i]) {
-      points_[i] = nullptr;
+      erasePoint(i);
       p->eraseObservation(this);
     }
   connectedWeights_.clear();
@@ -206,8 +212,9 @@ std::vector<int> KeyFrame::featuresInArea(float u, float v, float r) const {
 std::vector<MapPoint*> distinctGoodPoints(const std::vector<KeyFrame*>& keyFrames) {
   std::vector<MapPoint*> met;
   for (const KeyFrame* kf : keyFrames)
-    for (MapPoint* p : kf->points())
-      if (p && !p->isBad()) met.push_back(p);
+    kf->forEachPoint([&](MapPoint* p) {
+      if (!p->isBad()) met.push_back(p);
+    });
   // (point, position met) sorted: the first of each run of one point is its first meeting.
   std::vector<std::pair<MapPoint*, std::size_t>> byPoint(met.size());
   for (std::size_t i = 0; i < met.size(); ++i) byPoint[i] = {met[i], i};

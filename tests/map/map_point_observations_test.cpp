@@ -1,9 +1,11 @@
 // A map point's observations (map/map_point.hpp, ObservationList) stay in keyframe-id order
 // whatever order they arrive and leave in; distinctGoodPoints (map/key_frame.hpp) lists each good
-// point once, in the order first met.
+// point once, in the order first met; KeyFrame::forEachPoint visits exactly the non-null slots,
+// in slot order, whatever sequence of setPoint, erasePoint and setBad produced them.
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "orbis/map/map.hpp"
@@ -76,6 +78,62 @@ TEST(DistinctGoodPoints, ListsEachGoodPointOnceInTheOrderFirstMet) {
   EXPECT_EQ(distinctGoodPoints(kfs), (std::vector<MapPoint*>{points[3], points[1], points[4], points[0]}));
   EXPECT_EQ(distinctGoodPoints({kfs[2], kfs[1]}), (std::vector<MapPoint*>{points[4], points[0], points[1], points[3]}));
   EXPECT_TRUE(distinctGoodPoints({}).empty());
+}
+
+std::vector<MapPoint*> nonNullSlots(const KeyFrame& kf) {
+  std::vector<MapPoint*> out;
+  for (MapPoint* p : kf.points())
+    if (p) out.push_back(p);
+  return out;
+}
+
+std::vector<MapPoint*> visited(const KeyFrame& kf) {
+  std::vector<MapPoint*> out;
+  kf.forEachPoint([&](MapPoint* p) { out.push_back(p); });
+  return out;
+}
+
+TEST(KeyFramePoints, ForEachPointVisitsTheNonNullSlotsInOrder) {
+  std::mt19937 rng(7);
+  // Slot counts below, at and across the 64-slot words of the occupancy bits.
+  for (std::size_t slots : {1u, 63u, 64u, 65u, 200u, 1001u}) {
+    Map map;
+    KeyFrame* kf = map.createKeyFrame(0, 0, SE3d(), features(slots), MapIntrinsics{}, bow::BowVector{},
+                                      bow::FeatureVector{});
+    std::vector<MapPoint*> points;
+    for (int k = 0; k < 8; ++k) points.push_back(map.createMapPoint(Eigen::Vector3d(0, 0, 1 + k), kf, 0));
+    EXPECT_TRUE(visited(*kf).empty());
+    std::uniform_int_distribution<std::size_t> slot(0, slots - 1), which(0, points.size());
+    for (int step = 0; step < 3000; ++step) {
+      const std::size_t i = slot(rng), w = which(rng);
+      switch (step % 4) {
+        case 0:
+        case 1: kf->setPoint(i, w < points.size() ? points[w] : nullptr); break;  // null included
+        case 2: kf->erasePoint(i); break;
+        default: if (w < points.size()) kf->erasePoint(points[w]);  // every slot holding it
+      }
+      ASSERT_EQ(visited(*kf), nonNullSlots(*kf)) << slots << " slots, step " << step;
+    }
+    kf->setPoint(slots - 1, points[0]);
+    kf->setPoint(0, points[1]);
+    EXPECT_EQ(visited(*kf), nonNullSlots(*kf));
+    EXPECT_EQ(visited(*kf).back(), slots == 1 ? points[1] : points[0]);  // one slot: overwritten
+    EXPECT_EQ(visited(*kf).front(), points[1]);
+  }
+}
+
+TEST(KeyFramePoints, BadKeyFrameVisitsNothing) {
+  Map map;
+  KeyFrame* root = map.createKeyFrame(0, 0, SE3d(), features(100), MapIntrinsics{}, bow::BowVector{},
+                                      bow::FeatureVector{});
+  KeyFrame* kf = map.createKeyFrame(1, 1, SE3d(), features(100), MapIntrinsics{}, bow::BowVector{},
+                                    bow::FeatureVector{});
+  MapPoint* p = map.createMapPoint(Eigen::Vector3d(0, 0, 1), root, 0);
+  for (std::size_t i : {3u, 64u, 99u}) kf->setPoint(i, p);
+  EXPECT_EQ(visited(*kf).size(), 3u);
+  ASSERT_TRUE(kf->setBad());
+  EXPECT_TRUE(visited(*kf).empty());
+  EXPECT_TRUE(nonNullSlots(*kf).empty());
 }
 
 }  // namespace

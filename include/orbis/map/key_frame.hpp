@@ -8,6 +8,8 @@
 // monocular keypoint, and the few camera numbers the map needs travel in MapIntrinsics.
 #pragma once
 
+#include <bit>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -115,10 +117,25 @@ class KeyFrame {
   // @{
   // The map point of each keypoint (null: none); setting and erasing them.
   const std::vector<MapPoint*>& points() const { return points_; }
-  void setPoint(std::size_t i, MapPoint* p) { points_[i] = p; }
-  void erasePoint(std::size_t i) { points_[i] = nullptr; }
+  void setPoint(std::size_t i, MapPoint* p) {
+    points_[i] = p;
+    markSlot(i, p != nullptr);
+  }
+  void erasePoint(std::size_t i) {
+    points_[i] = nullptr;
+    markSlot(i, false);
+  }
   void erasePoint(const MapPoint* p);
   // @}
+  // Calls f(p) for every non-null slot's point, in slot order. It walks a bit per slot rather
+  // than the slots: most slots are null, and a branch on each mispredicted often enough to cost
+  // tracking's local-map update a third of its time (docs/notes/2026-11-29-speed-slot-bits.md).
+  template <class F>
+  void forEachPoint(F&& f) const {
+    for (std::size_t w = 0; w < occupied_.size(); ++w)
+      for (std::uint64_t bits = occupied_[w]; bits != 0; bits &= bits - 1)
+        f(points_[w * 64 + static_cast<std::size_t>(std::countr_zero(bits))]);
+  }
   // Map points with at least minObservations observations (ORB-SLAM's TrackedMapPoints).
   int trackedPoints(int minObservations) const;
   // Distinct good map points, ordered by id.
@@ -199,6 +216,11 @@ class KeyFrame {
 
  private:
   void updateBestCovisibles();
+  void markSlot(std::size_t i, bool occupied) {
+    const std::uint64_t bit = std::uint64_t{1} << (i % 64);
+    std::uint64_t& word = occupied_[i / 64];
+    word = occupied ? word | bit : word & ~bit;
+  }
 
   std::shared_ptr<const FrameFeatures> features_;
   mutable std::once_flag bowOnce_;
@@ -208,6 +230,7 @@ class KeyFrame {
   SE3d Tcw_;
   SE3d Tcp_;
   std::vector<MapPoint*> points_;
+  std::vector<std::uint64_t> occupied_;  // bit i: points_[i] is not null
   std::map<KeyFrame*, int, ById> connectedWeights_;
   std::vector<KeyFrame*> orderedConnected_;
   std::vector<int> orderedWeights_;

@@ -296,8 +296,9 @@ bool reprojectionOk(const Camera& camera, const KeyFrame& kf, std::size_t i, con
 inline double sceneMedianDepth(const KeyFrame& kf) {
   const SE3d Tcw = kf.Tcw();
   std::vector<double> depths;
-  for (const MapPoint* p : kf.points())
-    if (p && !p->isBad()) depths.push_back((Tcw * p->position()).z());
+  kf.forEachPoint([&](const MapPoint* p) {
+    if (!p->isBad()) depths.push_back((Tcw * p->position()).z());
+  });
   if (depths.empty()) return 0;
   const auto middle = depths.begin() + static_cast<std::ptrdiff_t>((depths.size() - 1) / 2);
   std::nth_element(depths.begin(), middle, depths.end());

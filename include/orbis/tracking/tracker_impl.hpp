@@ -434,13 +434,12 @@ void Tracker<Sensor>::updateLocalMap() {
   if (pointSlots_.size() < slots) pointSlots_.resize(slots);
   std::size_t n = 0;
   for (KeyFrame* kf : localKeyFrames_)
-    for (MapPoint* p : kf->points()) {
-      if (!p) continue;
+    kf->forEachPoint([&](MapPoint* p) {
       const bool fresh = !p->isBad() & (p->inLocalMapOf != stamp);
       p->inLocalMapOf = stamp;
       pointSlots_[n] = p;
       n += fresh;
-    }
+    });
   localPoints_.assign(pointSlots_.begin(), pointSlots_.begin() + static_cast<std::ptrdiff_t>(n));
 }
 
