@@ -369,6 +369,13 @@ bool Tracker<Sensor>::trackWithMotionModel(const SE3d& motion) {
   }
   note("motion_matches", n);
   if (n < 20) return false;
+  // The local map will be mostly the last frame's: ask for its points' first cache lines now, so
+  // that they arrive while motion-only BA computes (docs/notes/2026-11-29-speed-slot-bits.md).
+  for (const MapPoint* p : localPoints_) {
+    __builtin_prefetch(p);
+    __builtin_prefetch(reinterpret_cast<const char*>(p) + 64);
+    __builtin_prefetch(reinterpret_cast<const char*>(p) + 128);
+  }
   const int matchesMap = optimiseAndDropOutliers();
   note("motion_inliers", matchesMap);
   if (options_.localisationOnly) return current_.inliers() >= 10 || matchesMap >= 10;
@@ -455,6 +462,13 @@ int Tracker<Sensor>::searchLocalPoints() {
     }
     p->increaseVisible();
     p->matchedIn = stamp;
+  }
+  // The update read each point's first cache line; the frustum test also reads the next two
+  // (position, distances, viewing direction), fetched together here rather than one point after
+  // another in the loop (docs/notes/2026-11-29-speed-slot-bits.md).
+  for (const MapPoint* p : localPoints_) {
+    __builtin_prefetch(reinterpret_cast<const char*>(p) + 64);
+    __builtin_prefetch(reinterpret_cast<const char*>(p) + 128);
   }
   std::vector<MapPoint*> candidates;
   std::vector<matching::Projection> projections;
