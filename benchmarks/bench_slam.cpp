@@ -36,6 +36,7 @@
 #include "orbis/eval/metrics.hpp"
 #include "orbis/io/trajectory.hpp"
 #include "orbis/system/dataset_runner.hpp"
+#include "orbis/util/allocator.hpp"
 #include "orbis/util/error.hpp"
 
 namespace fs = std::filesystem;
@@ -299,6 +300,10 @@ Options parseArgs(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) try {
+  // Every SLAM run sets these allocator settings (SlamCore); set before the first cv::ORB pass too,
+  // or that pass alone re-faults its buffers on every frame and the first case's yardstick comes
+  // out about 2.7 times slower (docs/notes/2026-11-29-speed-slot-bits.md).
+  retainFreedMemory();
   const Options options = parseArgs(argc, argv);
   fs::create_directories(options.work);
   std::vector<Case> cases;
