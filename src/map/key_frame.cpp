@@ -36,11 +36,9 @@ void KeyFrame::ensureBow() const {
 }
 
 void KeyFrame::erasePoint(const MapPoint* p) {
-  for (std::size_t w = 0; w < occupied_.size(); ++w)
-    for (std::uint64_t bits = occupied_[w]; bits != 0; bits &= bits - 1) {
-      const std::size_t i = w * 64 + static_cast<std::size_t>(std::countr_zero(bits));
-      if (points_[i] == p) erasePoint(i);
-    }
+  forEachOccupiedSlot([&](std::size_t i) {
+    if (points_[i] == p) erasePoint(i);
+  });
 }
 
 int KeyFrame::trackedPoints(int minObservations) const {
@@ -158,11 +156,13 @@ void KeyFrame::changeParent(KeyFrame* parent) {
 bool KeyFrame::setBad() {
   if (mapRoot_ || protected_ || bad_) return false;
   for (const auto& [kf, w] : connectedWeights_) kf->eraseConnection(this);
-  for (std::size_t i = 0; i < points_.size(); ++i)
+  forEachOccupiedSlot([&](std::size_t i) {
+    // A point turning bad below detaches itself from this keyframe too, emptying slots ahead.
     if (MapPoint* p = points_[i]) {
       erasePoint(i);
       p->eraseObservation(this);
     }
+  });
   connectedWeights_.clear();
   orderedConnected_.clear();
   orderedWeights_.clear();

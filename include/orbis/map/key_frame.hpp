@@ -132,9 +132,7 @@ class KeyFrame {
   // tracking's local-map update a third of its time (docs/notes/2026-11-29-speed-slot-bits.md).
   template <class F>
   void forEachPoint(F&& f) const {
-    for (std::size_t w = 0; w < occupied_.size(); ++w)
-      for (std::uint64_t bits = occupied_[w]; bits != 0; bits &= bits - 1)
-        f(points_[w * 64 + static_cast<std::size_t>(std::countr_zero(bits))]);
+    forEachOccupiedSlot([&](std::size_t i) { f(points_[i]); });
   }
   // Map points with at least minObservations observations (ORB-SLAM's TrackedMapPoints).
   int trackedPoints(int minObservations) const;
@@ -216,6 +214,14 @@ class KeyFrame {
 
  private:
   void updateBestCovisibles();
+  // Calls f(i) for every slot i that was non-null when its 64-slot word was reached, in order:
+  // a slot f empties further on in the same word is still visited, and is then null.
+  template <class F>
+  void forEachOccupiedSlot(F&& f) const {
+    for (std::size_t w = 0; w < occupied_.size(); ++w)
+      for (std::uint64_t bits = occupied_[w]; bits != 0; bits &= bits - 1)
+        f(w * 64 + static_cast<std::size_t>(std::countr_zero(bits)));
+  }
   void markSlot(std::size_t i, bool occupied) {
     const std::uint64_t bit = std::uint64_t{1} << (i % 64);
     std::uint64_t& word = occupied_[i / 64];

@@ -10,6 +10,7 @@
 #include <span>
 
 #include "orbis/map/map_matching.hpp"
+#include "orbis/util/prefetch.hpp"
 
 namespace orbis::matching {
 
@@ -88,10 +89,7 @@ int matchFromLastFrame(Frame<Camera>& current, const Frame<Camera>& last, float 
   // The last frame's points are mostly cache misses by now (mapping has written them); asked for
   // one by one in the loop below they came one after another (docs/notes/2026-11-29-speed-slot-bits.md).
   for (const MapPoint* p : last.points)
-    if (p) {
-      __builtin_prefetch(p);
-      __builtin_prefetch(reinterpret_cast<const char*>(p) + 64);
-    }
+    if (p) prefetchLines(p, 0, 2);
   int matches = 0;
   for (std::size_t i = 0; i < last.size(); ++i) {
     MapPoint* p = last.points[i];

@@ -9,6 +9,7 @@
 #include "orbis/map/map_matching.hpp"
 #include "orbis/tracking/pose_optimizer.hpp"
 #include "orbis/tracking/tracker.hpp"
+#include "orbis/util/prefetch.hpp"
 
 namespace orbis {
 
@@ -371,11 +372,7 @@ bool Tracker<Sensor>::trackWithMotionModel(const SE3d& motion) {
   if (n < 20) return false;
   // The local map will be mostly the last frame's: ask for its points' first cache lines now, so
   // that they arrive while motion-only BA computes (docs/notes/2026-11-29-speed-slot-bits.md).
-  for (const MapPoint* p : localPoints_) {
-    __builtin_prefetch(p);
-    __builtin_prefetch(reinterpret_cast<const char*>(p) + 64);
-    __builtin_prefetch(reinterpret_cast<const char*>(p) + 128);
-  }
+  for (const MapPoint* p : localPoints_) prefetchLines(p, 0, 3);
   const int matchesMap = optimiseAndDropOutliers();
   note("motion_inliers", matchesMap);
   if (options_.localisationOnly) return current_.inliers() >= 10 || matchesMap >= 10;
@@ -466,10 +463,7 @@ int Tracker<Sensor>::searchLocalPoints() {
   // The update read each point's first cache line; the frustum test also reads the next two
   // (position, distances, viewing direction), fetched together here rather than one point after
   // another in the loop (docs/notes/2026-11-29-speed-slot-bits.md).
-  for (const MapPoint* p : localPoints_) {
-    __builtin_prefetch(reinterpret_cast<const char*>(p) + 64);
-    __builtin_prefetch(reinterpret_cast<const char*>(p) + 128);
-  }
+  for (const MapPoint* p : localPoints_) prefetchLines(p, 1, 2);
   std::vector<MapPoint*> candidates;
   std::vector<matching::Projection> projections;
   const Eigen::Vector3d centre = current_.cameraCenter();
